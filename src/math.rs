@@ -1,0 +1,30 @@
+//! Scalar and small vector types shared by every module, and tolerances.
+
+/// The scalar type of all geometry: positions, weights, energies.
+pub type Real = f64;
+/// A point in 3-space.
+pub type Point3 = nalgebra::Point3<Real>;
+/// A vector in 3-space.
+pub type Vector3 = nalgebra::Vector3<Real>;
+
+/// Relative tolerance used when comparing geometry against references.
+pub const REL_TOL: Real = 1e-9;
+
+/// Axis-aligned bounding box of a set of points; `None` for an empty set.
+pub fn bounding_box(points: &[Point3]) -> Option<(Point3, Point3)> {
+    let first = points.first()?;
+    let mut lo = *first;
+    let mut hi = *first;
+    for p in points {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    Some((lo, hi))
+}
+
+/// Length of the bounding-box diagonal (0 for an empty or single-point set).
+pub fn bbox_diagonal(points: &[Point3]) -> Real {
+    bounding_box(points).map_or(0.0, |(lo, hi)| (hi - lo).norm())
+}

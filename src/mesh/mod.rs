@@ -1,0 +1,7 @@
+//! Geometry containers: polygon meshes and point clouds.
+
+mod point_cloud;
+mod poly_mesh;
+
+pub use point_cloud::PointCloud;
+pub use poly_mesh::PolyMesh;

@@ -1,0 +1,356 @@
+//! `StencilTable`: a sparse row-major (CSR) matrix of weights over control points.
+//!
+//! Row `r` says `out[r] = Σ_k weights[k] · in[indices[k]]` for `k` in
+//! `offsets[r]..offsets[r + 1]`. Refinement levels, limit evaluation and FFD are
+//! all such tables (the model is OpenSubdiv's `Far::StencilTable`).
+
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::math::{Point3, Real};
+
+/// A sparse matrix in compressed-row form with `u32` column indices.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StencilTable {
+    /// Number of columns (control points the rows refer to).
+    pub num_cols: usize,
+    /// `num_rows + 1` offsets into `indices` / `weights`.
+    pub offsets: Vec<usize>,
+    /// Column index of each weight.
+    pub indices: Vec<u32>,
+    /// The weights.
+    pub weights: Vec<Real>,
+}
+
+/// Rows per parallel task when applying or composing tables.
+const CHUNK: usize = 4096;
+
+impl StencilTable {
+    /// The `n × n` identity.
+    pub fn identity(n: usize) -> Self {
+        StencilTable {
+            num_cols: n,
+            offsets: (0..=n).collect(),
+            indices: (0..n as u32).collect(),
+            weights: vec![1.0; n],
+        }
+    }
+
+    /// An empty table with `num_cols` columns, ready for [`push_row`](Self::push_row).
+    pub fn with_capacity(num_cols: usize, rows: usize, entries: usize) -> Self {
+        let mut offsets = Vec::with_capacity(rows + 1);
+        offsets.push(0);
+        StencilTable {
+            num_cols,
+            offsets,
+            indices: Vec::with_capacity(entries),
+            weights: Vec::with_capacity(entries),
+        }
+    }
+
+    /// Builds a table from rows of `(column, weight)` pairs; repeated columns
+    /// within a row are summed.
+    pub fn from_rows(num_cols: usize, rows: &[Vec<(u32, Real)>]) -> Self {
+        let mut t = Self::with_capacity(num_cols, rows.len(), rows.iter().map(Vec::len).sum());
+        for r in rows {
+            t.push_row(r.iter().copied());
+        }
+        t
+    }
+
+    /// Appends one row; repeated columns are merged by summing their weights.
+    pub fn push_row(&mut self, entries: impl IntoIterator<Item = (u32, Real)>) {
+        let start = *self.offsets.last().unwrap_or(&0);
+        for (c, w) in entries {
+            debug_assert!((c as usize) < self.num_cols);
+            if let Some(k) = self.indices[start..].iter().position(|&x| x == c) {
+                self.weights[start + k] += w;
+            } else {
+                self.indices.push(c);
+                self.weights.push(w);
+            }
+        }
+        self.offsets.push(self.indices.len());
+    }
+
+    /// Number of rows.
+    pub fn num_rows(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// Number of stored weights.
+    pub fn num_entries(&self) -> usize {
+        self.indices.len()
+    }
+
+    /// Columns and weights of row `r`.
+    pub fn row(&self, r: usize) -> (&[u32], &[Real]) {
+        let (a, b) = (self.offsets[r], self.offsets[r + 1]);
+        (&self.indices[a..b], &self.weights[a..b])
+    }
+
+    /// Applies the table to points: `out[r] = Σ w · points[c]`.
+    pub fn apply(&self, points: &[Point3]) -> Result<Vec<Point3>> {
+        self.check_input(points.len())?;
+        let mut out = vec![Point3::origin(); self.num_rows()];
+        self.apply_into(points, &mut out);
+        Ok(out)
+    }
+
+    /// Applies the table into a caller-provided buffer of `num_rows` points
+    /// (no allocation; rows are processed in parallel).
+    ///
+    /// Panics if the sizes disagree; [`apply`](Self::apply) checks them first.
+    pub fn apply_into(&self, points: &[Point3], out: &mut [Point3]) {
+        assert_eq!(points.len(), self.num_cols);
+        assert_eq!(out.len(), self.num_rows());
+        out.par_chunks_mut(CHUNK).enumerate().for_each(|(ci, chunk)| {
+            let r0 = ci * CHUNK;
+            for (i, o) in chunk.iter_mut().enumerate() {
+                let (a, b) = (self.offsets[r0 + i], self.offsets[r0 + i + 1]);
+                let (mut x, mut y, mut z) = (0.0, 0.0, 0.0);
+                for k in a..b {
+                    let p = &points[self.indices[k] as usize];
+                    let w = self.weights[k];
+                    x += w * p.x;
+                    y += w * p.y;
+                    z += w * p.z;
+                }
+                *o = Point3::new(x, y, z);
+            }
+        });
+    }
+
+    /// Applies the table to scalar values (one per column).
+    pub fn apply_scalar(&self, values: &[Real]) -> Result<Vec<Real>> {
+        self.check_input(values.len())?;
+        Ok((0..self.num_rows())
+            .into_par_iter()
+            .map(|r| {
+                let (c, w) = self.row(r);
+                c.iter().zip(w).map(|(&c, &w)| w * values[c as usize]).sum()
+            })
+            .collect())
+    }
+
+    /// Applies the transpose: `out[c] = Σ_r w_rc · values[r]`, the map that
+    /// turns forces on samples into forces on control points (`Jᵀ f`).
+    pub fn apply_transpose(&self, values: &[Point3]) -> Result<Vec<Point3>> {
+        if values.len() != self.num_rows() {
+            return Err(Error::Input(format!(
+                "stencil table has {} rows but {} values were given",
+                self.num_rows(),
+                values.len()
+            )));
+        }
+        let mut out = vec![Point3::origin(); self.num_cols];
+        for (r, v) in values.iter().enumerate() {
+            let (c, w) = self.row(r);
+            for (&c, &w) in c.iter().zip(w) {
+                out[c as usize].coords += w * v.coords;
+            }
+        }
+        Ok(out)
+    }
+
+    /// The transposed table (`num_cols × num_rows`).
+    pub fn transpose(&self) -> StencilTable {
+        let mut counts = vec![0usize; self.num_cols + 1];
+        for &c in &self.indices {
+            counts[c as usize + 1] += 1;
+        }
+        for i in 0..self.num_cols {
+            counts[i + 1] += counts[i];
+        }
+        let offsets = counts.clone();
+        let mut next = counts;
+        let mut indices = vec![0u32; self.num_entries()];
+        let mut weights = vec![0.0; self.num_entries()];
+        for r in 0..self.num_rows() {
+            let (c, w) = self.row(r);
+            for (&c, &w) in c.iter().zip(w) {
+                let k = next[c as usize];
+                indices[k] = r as u32;
+                weights[k] = w;
+                next[c as usize] += 1;
+            }
+        }
+        StencilTable {
+            num_cols: self.num_rows(),
+            offsets,
+            indices,
+            weights,
+        }
+    }
+
+    /// The product `self · inner`: rows of `self` expressed over the columns
+    /// of `inner`. Composing `S_{n-1} ⋯ S_0` gives `P_n = S P_0`.
+    /// Weights smaller than `1e-300` in magnitude after summation are dropped.
+    pub fn compose(&self, inner: &StencilTable) -> Result<StencilTable> {
+        if self.num_cols != inner.num_rows() {
+            return Err(Error::Input(format!(
+                "cannot compose: outer table has {} columns, inner has {} rows",
+                self.num_cols,
+                inner.num_rows()
+            )));
+        }
+        let n = self.num_rows();
+        let ncols = inner.num_cols;
+        // Per-thread dense accumulator with a list of touched columns (a sparse
+        // accumulator), so each output row costs only its own fill.
+        let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<Real>)> = (0..n.div_ceil(CHUNK))
+            .into_par_iter()
+            .map_init(
+                || (vec![0.0; ncols], vec![false; ncols], Vec::<u32>::new()),
+                |(acc, seen, touched), ci| {
+                    let (r0, r1) = (ci * CHUNK, ((ci + 1) * CHUNK).min(n));
+                    let mut lens = Vec::with_capacity(r1 - r0);
+                    let mut idx = Vec::new();
+                    let mut wts = Vec::new();
+                    for r in r0..r1 {
+                        let (oc, ow) = self.row(r);
+                        for (&m, &a) in oc.iter().zip(ow) {
+                            let (ic, iw) = inner.row(m as usize);
+                            for (&c, &b) in ic.iter().zip(iw) {
+                                let cu = c as usize;
+                                if !seen[cu] {
+                                    seen[cu] = true;
+                                    touched.push(c);
+                                }
+                                acc[cu] += a * b;
+                            }
+                        }
+                        let before = idx.len();
+                        for &c in touched.iter() {
+                            let cu = c as usize;
+                            let w = acc[cu];
+                            if w.abs() > 1e-300 {
+                                idx.push(c);
+                                wts.push(w);
+                            }
+                            acc[cu] = 0.0;
+                            seen[cu] = false;
+                        }
+                        touched.clear();
+                        lens.push(idx.len() - before);
+                    }
+                    (lens, idx, wts)
+                },
+            )
+            .collect();
+        Ok(Self::from_chunks(ncols, n, chunks))
+    }
+
+    /// A table made of the given rows of this one, in the given order.
+    pub fn select_rows(&self, rows: &[usize]) -> StencilTable {
+        let mut t = Self::with_capacity(self.num_cols, rows.len(), 0);
+        for &r in rows {
+            let (c, w) = self.row(r);
+            t.indices.extend_from_slice(c);
+            t.weights.extend_from_slice(w);
+            t.offsets.push(t.indices.len());
+        }
+        t
+    }
+
+    /// Sum of the weights of each row (1 for an affine-invariant stencil).
+    pub fn row_sums(&self) -> Vec<Real> {
+        (0..self.num_rows()).map(|r| self.row(r).1.iter().sum()).collect()
+    }
+
+    fn check_input(&self, n: usize) -> Result<()> {
+        if n != self.num_cols {
+            return Err(Error::Input(format!(
+                "stencil table expects {} control points, got {n}",
+                self.num_cols
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Accumulates one stencil row, merging repeated columns.
+#[derive(Default, Debug)]
+pub struct RowBuilder {
+    cols: Vec<u32>,
+    wts: Vec<Real>,
+}
+
+impl RowBuilder {
+    /// Adds `w` to the weight of column `c`.
+    #[inline]
+    pub fn add(&mut self, c: u32, w: Real) {
+        match self.cols.iter().position(|&x| x == c) {
+            Some(k) => self.wts[k] += w,
+            None => {
+                self.cols.push(c);
+                self.wts.push(w);
+            }
+        }
+    }
+
+    /// Adds every entry of another row scaled by `s`.
+    pub fn add_scaled(&mut self, other: &RowBuilder, s: Real) {
+        for (&c, &w) in other.cols.iter().zip(&other.wts) {
+            self.add(c, s * w);
+        }
+    }
+
+    /// Removes all entries.
+    pub fn clear(&mut self) {
+        self.cols.clear();
+        self.wts.clear();
+    }
+
+    /// The entries so far.
+    pub fn entries(&self) -> impl Iterator<Item = (u32, Real)> + '_ {
+        self.cols.iter().copied().zip(self.wts.iter().copied())
+    }
+}
+
+impl StencilTable {
+    /// Builds `num_rows` rows in parallel; `row(r, b)` fills row `r` into an
+    /// empty [`RowBuilder`] `b`.
+    pub fn from_row_fn(
+        num_rows: usize,
+        num_cols: usize,
+        row: impl Fn(usize, &mut RowBuilder) + Sync,
+    ) -> StencilTable {
+        let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<Real>)> = (0..num_rows.div_ceil(CHUNK))
+            .into_par_iter()
+            .map_init(RowBuilder::default, |b, ci| {
+                let (r0, r1) = (ci * CHUNK, ((ci + 1) * CHUNK).min(num_rows));
+                let mut lens = Vec::with_capacity(r1 - r0);
+                let mut idx = Vec::with_capacity(8 * (r1 - r0));
+                let mut wts = Vec::with_capacity(8 * (r1 - r0));
+                for r in r0..r1 {
+                    b.clear();
+                    row(r, b);
+                    lens.push(b.cols.len());
+                    idx.extend_from_slice(&b.cols);
+                    wts.extend_from_slice(&b.wts);
+                }
+                (lens, idx, wts)
+            })
+            .collect();
+        Self::from_chunks(num_cols, num_rows, chunks)
+    }
+
+    fn from_chunks(
+        num_cols: usize,
+        num_rows: usize,
+        chunks: Vec<(Vec<usize>, Vec<u32>, Vec<Real>)>,
+    ) -> StencilTable {
+        let mut out =
+            StencilTable::with_capacity(num_cols, num_rows, chunks.iter().map(|c| c.1.len()).sum());
+        for (lens, idx, wts) in chunks {
+            for l in lens {
+                let last = *out.offsets.last().unwrap_or(&0);
+                out.offsets.push(last + l);
+            }
+            out.indices.extend_from_slice(&idx);
+            out.weights.extend_from_slice(&wts);
+        }
+        out
+    }
+}

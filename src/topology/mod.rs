@@ -1,0 +1,8 @@
+//! Connectivity without positions: edges, adjacency, boundaries, valences,
+//! crease sharpness.
+
+mod level;
+mod sharpness;
+
+pub use level::{Level, NONE, VertexRing, face_of_corner};
+pub use sharpness::{SHARPNESS_INFINITE, Sharpness, VertexRule, decrement, find_edge};
