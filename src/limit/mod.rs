@@ -1,1 +1,16 @@
-//! Limit surface evaluation.
+//! The limit surface: vertex limit masks, exact evaluation at `(face, u, v)`
+//! with derivatives as stencil rows, tessellation and closest points.
+
+mod bspline;
+mod evaluator;
+mod limit_stencil;
+mod patch;
+mod tessellate;
+mod vertex_masks;
+
+pub use bspline::{cubic_basis, patch_weights};
+pub use evaluator::{LimitEvaluator, LimitPoint, LimitStencils, Sample};
+pub use limit_stencil::limit_stencil;
+pub use patch::SampleStencil;
+pub use tessellate::tessellate;
+pub use vertex_masks::CornerKind;

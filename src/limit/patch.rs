@@ -1,0 +1,395 @@
+//! Exact evaluation of the limit surface at `(face, u, v)` by local
+//! subdivision (Stam 1998 evaluates the same surface through an eigenbasis;
+//! we subdivide the face's neighbourhood instead, which also covers
+//! boundaries and creases with the refiner's own rules).
+//!
+//! The 1-ring of the face (all faces sharing a vertex with it) is cut out and
+//! subdivided locally until the sub-face holding `(u, v)` is a regular
+//! bicubic B-spline patch — interior corners of valence 4, or boundary /
+//! infinitely sharp corners whose missing points are reflections
+//! `2 P_b − P_i` — and the patch is evaluated there. The rows of the local
+//! vertices are kept as weights over the base control points, so the result
+//! is a limit stencil (a Jacobian row), not just a point. Only the 1-ring is
+//! needed: the refined 1-ring of a sub-face depends on the 1-ring of its
+//! parent alone (vertex rules read only the corners' rings, which are whole).
+
+use crate::math::Real;
+use crate::stencil::RowBuilder;
+use crate::subdivision::{refine_stencil, refine_topology};
+use crate::topology::{Level, SHARPNESS_INFINITE, Sharpness, find_edge};
+
+use super::bspline::patch_weights;
+use super::vertex_masks::{CornerKind, corner_kind, corner_tangents, limit_position_mask, masks_apply};
+
+/// Deepest local subdivision; a point within `2⁻⁴⁰` of an irregular corner
+/// is evaluated at the corner.
+const MAX_DEPTH: usize = 40;
+/// Depth at which derivatives at an irregular corner are taken (OpenSubdiv
+/// `Bfr`'s default smooth approximation level).
+const CORNER_DEPTH: usize = 2;
+
+/// A limit sample as weights over control points: value and the
+/// derivatives `∂u, ∂v, ∂uu, ∂uv, ∂vv` (one weight array each).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SampleStencil {
+    /// Control points the weights refer to.
+    pub cols: Vec<u32>,
+    /// `weights[k][i]` is the weight of `cols[i]` in quantity `k`
+    /// (0 = position, 1 = ∂u, 2 = ∂v, 3 = ∂uu, 4 = ∂uv, 5 = ∂vv).
+    pub weights: [Vec<Real>; 6],
+}
+
+/// A neighbourhood of one face, with every local vertex as a dense row of
+/// weights over `cols`.
+struct LocalPatch {
+    level: Level,
+    sharp: Sharpness,
+    cols: Vec<u32>,
+    /// `level.num_vertices × cols.len()`, row-major.
+    rows: Vec<Real>,
+    /// Local index of the face being followed.
+    face: u32,
+}
+
+impl LocalPatch {
+    /// The 1-ring of `face` in `level`, with identity rows over its vertices.
+    fn around(level: &Level, sharp: &Sharpness, face: usize) -> LocalPatch {
+        let (sub, map) = one_ring(level, sharp, face);
+        let n = map.len();
+        let mut rows = vec![0.0; n * n];
+        for i in 0..n {
+            rows[i * n + i] = 1.0;
+        }
+        LocalPatch {
+            level: sub.0,
+            sharp: sub.1,
+            cols: map,
+            rows,
+            face: sub.2,
+        }
+    }
+
+    fn ncols(&self) -> usize {
+        self.cols.len()
+    }
+
+    /// Subdivides once and keeps the 1-ring of the child of the current face
+    /// at corner `k`.
+    fn descend(&mut self, k: usize) {
+        let child = refine_topology(&self.level);
+        let (s, child_sharp) = refine_stencil(&self.level, &self.sharp, &child);
+        let cface = self.level.face_offsets[self.face as usize] as usize + k;
+        let (sub, map) = one_ring(&child, &child_sharp, cface);
+        let nc = self.ncols();
+        let mut rows = vec![0.0; map.len() * nc];
+        for (i, &cv) in map.iter().enumerate() {
+            let (idx, w) = s.row(cv as usize);
+            let out = &mut rows[i * nc..(i + 1) * nc];
+            for (&p, &w) in idx.iter().zip(w) {
+                let src = &self.rows[p as usize * nc..(p as usize + 1) * nc];
+                for (o, &x) in out.iter_mut().zip(src) {
+                    *o += w * x;
+                }
+            }
+        }
+        self.level = sub.0;
+        self.sharp = sub.1;
+        self.rows = rows;
+        self.face = sub.2;
+    }
+
+    /// Adds `scale ×` the row of local vertex-combination `b` into `out`.
+    fn accumulate(&self, b: &RowBuilder, scale: Real, out: &mut [Real]) {
+        let nc = self.ncols();
+        for (v, w) in b.entries() {
+            let src = &self.rows[v as usize * nc..(v as usize + 1) * nc];
+            for (o, &x) in out.iter_mut().zip(src) {
+                *o += scale * w * x;
+            }
+        }
+    }
+}
+
+/// The sub-mesh of faces sharing a vertex with `face`: its level, sharpness
+/// (rim edges marked infinitely sharp so rim vertices stay well defined),
+/// the local index of `face`, and the map local vertex → vertex of `level`.
+fn one_ring(level: &Level, sharp: &Sharpness, face: usize) -> ((Level, Sharpness, u32), Vec<u32>) {
+    let mut faces: Vec<u32> = vec![face as u32];
+    for &v in level.face_vertices(face) {
+        for &g in level.vertex_faces(v as usize) {
+            if !faces.contains(&g) {
+                faces.push(g);
+            }
+        }
+    }
+    let mut map: Vec<u32> = Vec::new();
+    let mut offsets = vec![0u32];
+    let mut verts = Vec::new();
+    for &g in &faces {
+        for &v in level.face_vertices(g as usize) {
+            let l = match map.iter().position(|&x| x == v) {
+                Some(l) => l,
+                None => {
+                    map.push(v);
+                    map.len() - 1
+                }
+            };
+            verts.push(l as u32);
+        }
+        offsets.push(verts.len() as u32);
+    }
+    let sub = Level::from_faces(map.len(), &offsets, &verts)
+        .expect("a sub-mesh of a valid level is valid");
+    let edge = sub
+        .edge_verts
+        .iter()
+        .enumerate()
+        .map(|(e, &[a, b])| {
+            if sub.is_boundary_edge(e) {
+                SHARPNESS_INFINITE
+            } else {
+                find_edge(level, map[a as usize], map[b as usize]).map_or(0.0, |g| sharp.edge[g])
+            }
+        })
+        .collect();
+    let vertex = map.iter().map(|&v| sharp.vertex[v as usize]).collect();
+    ((sub, Sharpness { edge, vertex }, 0), map)
+}
+
+/// Parameter position of corner `k` of a quad.
+const CORNERS: [[Real; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+/// Outward direction of quad edge `k` in the 4×4 grid.
+const OUT: [[i32; 2]; 4] = [[0, -1], [1, 0], [0, 1], [-1, 0]];
+/// Grid position of quad corner `k`.
+const GRID: [[i32; 2]; 4] = [[1, 1], [2, 1], [2, 2], [1, 2]];
+
+/// Evaluates the limit surface of `level` (with `sharp`) at `(u, v)` of base
+/// face `face`, returning weights over `level`'s vertices. Non-quads use
+/// quad sub-faces: sub-face `i` (corner `i`, towards the midpoint of edge
+/// `i`, the centroid, the midpoint of edge `i − 1`) occupies
+/// `[tu, tu + ½] × [tv, tv + ½]` with tile `(tu, tv) = (i mod d, i div d)`,
+/// `d = ⌈√n⌉` (OpenSubdiv `Bfr`'s quad-subface parameterisation).
+pub fn evaluate_face(level: &Level, sharp: &Sharpness, face: usize, u: Real, v: Real) -> SampleStencil {
+    let mut patch = LocalPatch::around(level, sharp, face);
+    let n = level.face_vertices(face).len();
+    // (s, t) = a · (u, v) + offset with a = jac (2×2), tracked for the chain rule.
+    let mut st = [u.clamp(0.0, 1.0), v.clamp(0.0, 1.0)];
+    let mut jac = [[1.0, 0.0], [0.0, 1.0]];
+    let mut depth = 0;
+    if n != 4 {
+        let d = (n as Real).sqrt().ceil() as usize;
+        let rows = n.div_ceil(d);
+        let tu = ((u + 0.25).floor().max(0.0) as usize).min(d - 1);
+        let tv = ((v + 0.25).floor().max(0.0) as usize).min(rows - 1);
+        let i = (tv * d + tu).min(n - 1);
+        let (tu, tv) = ((i % d) as Real, (i / d) as Real);
+        st = [
+            (2.0 * (u - tu)).clamp(0.0, 1.0),
+            (2.0 * (v - tv)).clamp(0.0, 1.0),
+        ];
+        jac = [[2.0, 0.0], [0.0, 2.0]];
+        patch.descend(i);
+        depth = 1;
+    }
+    loop {
+        let f = patch.face;
+        let fv: Vec<u32> = patch.level.face_vertices(f as usize).to_vec();
+        let kinds: Vec<CornerKind> = fv
+            .iter()
+            .map(|&c| corner_kind(&patch.level, &patch.sharp, c as usize, f))
+            .collect();
+        if kinds.iter().all(|&k| k != CornerKind::Irregular) {
+            return regular_patch(&patch, &fv, st, jac);
+        }
+        if depth >= MAX_DEPTH {
+            // Within 2⁻⁴⁰ of a corner that is still irregular: evaluate there.
+            let near = (0..4)
+                .min_by(|&a, &b| {
+                    let da = (CORNERS[a][0] - st[0]).abs() + (CORNERS[a][1] - st[1]).abs();
+                    let db = (CORNERS[b][0] - st[0]).abs() + (CORNERS[b][1] - st[1]).abs();
+                    da.total_cmp(&db)
+                })
+                .unwrap_or(0);
+            st = CORNERS[near];
+        }
+        if let Some(k) = CORNERS.iter().position(|c| c[0] == st[0] && c[1] == st[1]) {
+            let c = fv[k] as usize;
+            if kinds[k] == CornerKind::Irregular
+                && depth >= CORNER_DEPTH
+                && masks_apply(&patch.level, &patch.sharp, c)
+            {
+                return irregular_corner(&patch, c, k, jac);
+            }
+        }
+        // Descend into the quadrant holding (s, t); ties go up, as in Bfr.
+        let k = match (st[0] >= 0.5, st[1] >= 0.5) {
+            (false, false) => 0,
+            (true, false) => 1,
+            (true, true) => 2,
+            (false, true) => 3,
+        };
+        // Child k: corner 0 at parent corner k, s towards corner k+1, t towards k−1.
+        let o = CORNERS[k];
+        let a = sub(CORNERS[(k + 1) % 4], o);
+        let b = sub(CORNERS[(k + 3) % 4], o);
+        let d = sub(st, o);
+        st = [
+            (2.0 * (d[0] * a[0] + d[1] * a[1])).clamp(0.0, 1.0),
+            (2.0 * (d[0] * b[0] + d[1] * b[1])).clamp(0.0, 1.0),
+        ];
+        // new jac rows: 2 a·jac, 2 b·jac
+        jac = [
+            [
+                2.0 * (a[0] * jac[0][0] + a[1] * jac[1][0]),
+                2.0 * (a[0] * jac[0][1] + a[1] * jac[1][1]),
+            ],
+            [
+                2.0 * (b[0] * jac[0][0] + b[1] * jac[1][0]),
+                2.0 * (b[0] * jac[0][1] + b[1] * jac[1][1]),
+            ],
+        ];
+        patch.descend(k);
+        depth += 1;
+    }
+}
+
+fn sub(a: [Real; 2], b: [Real; 2]) -> [Real; 2] {
+    [a[0] - b[0], a[1] - b[1]]
+}
+
+/// Evaluates a regular patch: gathers the 4×4 grid (phantoms by reflection)
+/// and maps derivatives from `(s, t)` back to the base `(u, v)`.
+fn regular_patch(patch: &LocalPatch, fv: &[u32], st: [Real; 2], jac: [[Real; 2]; 2]) -> SampleStencil {
+    let level = &patch.level;
+    let f = patch.face as usize;
+    let fe = level.face_edge_list(f);
+    let inf = |e: u32| {
+        patch.sharp.edge[e as usize] >= SHARPNESS_INFINITE || level.is_boundary_edge(e as usize)
+    };
+    let mut grid: Vec<Option<RowBuilder>> = (0..16).map(|_| None).collect();
+    let at = |p: [i32; 2]| (4 * p[0] + p[1]) as usize;
+    let single = |v: u32| {
+        let mut b = RowBuilder::default();
+        b.add(v, 1.0);
+        b
+    };
+    for k in 0..4 {
+        grid[at(GRID[k])] = Some(single(fv[k]));
+    }
+    let add = |g: [i32; 2], o: [i32; 2]| [g[0] + o[0], g[1] + o[1]];
+    let reflect = |grid: &Vec<Option<RowBuilder>>, p: [i32; 2], inner: [i32; 2]| {
+        // 2 P(p) − P(inner)
+        let mut b = RowBuilder::default();
+        if let (Some(x), Some(y)) = (&grid[at(p)], &grid[at(inner)]) {
+            b.add_scaled(x, 2.0);
+            b.add_scaled(y, -1.0);
+        }
+        b
+    };
+    // Points across each edge.
+    for k in 0..4 {
+        let (ck, cn) = (GRID[k], GRID[(k + 1) % 4]);
+        let o = OUT[k];
+        if inf(fe[k]) {
+            for g in [ck, cn] {
+                let inner = [g[0] - o[0], g[1] - o[1]];
+                grid[at(add(g, o))] = Some(reflect(&grid, g, inner));
+            }
+        } else {
+            let [f0, f1] = level.edge_faces[fe[k] as usize];
+            let g = if f0 as usize == f { f1 } else { f0 } as usize;
+            let gv = level.face_vertices(g);
+            // In g the edge runs fv[k+1] -> fv[k]; then x (next to fv[k]), y (next to fv[k+1]).
+            let i = gv.iter().position(|&x| x == fv[k]).unwrap_or(0);
+            let x = gv[(i + 1) % 4];
+            let y = gv[(i + 2) % 4];
+            grid[at(add(ck, o))] = Some(single(x));
+            grid[at(add(cn, o))] = Some(single(y));
+        }
+    }
+    // Diagonal points at each corner.
+    for k in 0..4 {
+        let g = GRID[k];
+        let (o_lead, o_trail) = (OUT[k], OUT[(k + 3) % 4]);
+        let d = add(add(g, o_lead), o_trail);
+        let (cut_lead, cut_trail) = (inf(fe[k]), inf(fe[(k + 3) % 4]));
+        let b = if cut_lead {
+            // reflect across the leading edge: 2 P(g + o_trail) − P(g + o_trail − o_lead)
+            let p = add(g, o_trail);
+            reflect(&grid, p, [p[0] - o_lead[0], p[1] - o_lead[1]])
+        } else if cut_trail {
+            let p = add(g, o_lead);
+            reflect(&grid, p, [p[0] - o_trail[0], p[1] - o_trail[1]])
+        } else {
+            // Smooth valence-4 corner: the face opposite in the ring.
+            let ring = level.vertex_ring(fv[k] as usize);
+            let i = ring.faces.iter().position(|&x| x as usize == f).unwrap_or(0);
+            let opp = ring.faces[(i + 2) % ring.faces.len()] as usize;
+            let ov = level.face_vertices(opp);
+            let j = ov.iter().position(|&x| x == fv[k]).unwrap_or(0);
+            single(ov[(j + 2) % 4])
+        };
+        grid[at(d)] = Some(b);
+    }
+    let w = patch_weights(st[0], st[1]);
+    let nc = patch.ncols();
+    // Derivatives in (s, t), then chain rule to (u, v).
+    let mut local: [Vec<Real>; 6] = std::array::from_fn(|_| vec![0.0; nc]);
+    for (i, g) in grid.iter().enumerate() {
+        if let Some(b) = g {
+            for q in 0..6 {
+                if w[q][i] != 0.0 {
+                    patch.accumulate(b, w[q][i], &mut local[q]);
+                }
+            }
+        }
+    }
+    chain_rule(patch, local, jac)
+}
+
+/// Maps `(P, Ps, Pt, Pss, Pst, Ptt)` to `(P, Pu, Pv, Puu, Puv, Pvv)` with
+/// `(s, t) = J (u, v) + c`.
+fn chain_rule(patch: &LocalPatch, local: [Vec<Real>; 6], j: [[Real; 2]; 2]) -> SampleStencil {
+    let (su, sv, tu, tv) = (j[0][0], j[0][1], j[1][0], j[1][1]);
+    let nc = patch.ncols();
+    let mut out: [Vec<Real>; 6] = std::array::from_fn(|_| vec![0.0; nc]);
+    for i in 0..nc {
+        let [p, ps, pt, pss, pst, ptt] = [0, 1, 2, 3, 4, 5].map(|q| local[q][i]);
+        out[0][i] = p;
+        out[1][i] = ps * su + pt * tu;
+        out[2][i] = ps * sv + pt * tv;
+        out[3][i] = pss * su * su + 2.0 * pst * su * tu + ptt * tu * tu;
+        out[4][i] = pss * su * sv + pst * (su * tv + sv * tu) + ptt * tu * tv;
+        out[5][i] = pss * sv * sv + 2.0 * pst * sv * tv + ptt * tv * tv;
+    }
+    SampleStencil {
+        cols: patch.cols.clone(),
+        weights: out,
+    }
+}
+
+/// Position and first derivatives exactly at irregular corner `k` of the
+/// current face (second derivatives are reported as zero there: the
+/// surface has no bounded curvature parameterisation at such a point).
+fn irregular_corner(patch: &LocalPatch, c: usize, k: usize, jac: [[Real; 2]; 2]) -> SampleStencil {
+    let nc = patch.ncols();
+    let mut local: [Vec<Real>; 6] = std::array::from_fn(|_| vec![0.0; nc]);
+    let mut pos = RowBuilder::default();
+    limit_position_mask(&patch.level, &patch.sharp, c, 1.0, &mut pos);
+    patch.accumulate(&pos, 1.0, &mut local[0]);
+    let (lead, trail) = corner_tangents(&patch.level, &patch.sharp, c, patch.face);
+    // Along the leading edge the parameter moves by a = corner(k+1) − corner(k),
+    // along the trailing edge by b = corner(k−1) − corner(k); ∇ = 3 (a T_lead + b T_trail).
+    let a = sub(CORNERS[(k + 1) % 4], CORNERS[k]);
+    let b = sub(CORNERS[(k + 3) % 4], CORNERS[k]);
+    for q in 0..2 {
+        let (x, y) = (a[q], b[q]);
+        if x != 0.0 {
+            patch.accumulate(&lead, 3.0 * x, &mut local[1 + q]);
+        }
+        if y != 0.0 {
+            patch.accumulate(&trail, 3.0 * y, &mut local[1 + q]);
+        }
+    }
+    chain_rule(patch, local, jac)
+}
