@@ -2,6 +2,7 @@
 //! with derivatives as stencil rows, tessellation and closest points.
 
 mod bspline;
+mod closest;
 mod evaluator;
 mod limit_stencil;
 mod patch;
@@ -9,6 +10,7 @@ mod tessellate;
 mod vertex_masks;
 
 pub use bspline::{cubic_basis, patch_weights};
+pub use closest::{ClosestPoint, ClosestPointEngine, ClosestPointParams};
 pub use evaluator::{LimitEvaluator, LimitPoint, LimitStencils, Sample};
 pub use limit_stencil::limit_stencil;
 pub use patch::SampleStencil;

@@ -199,7 +199,7 @@ pub fn evaluate_face(level: &Level, sharp: &Sharpness, face: usize, u: Real, v: 
             .map(|&c| corner_kind(&patch.level, &patch.sharp, c as usize, f))
             .collect();
         if kinds.iter().all(|&k| k != CornerKind::Irregular) {
-            return regular_patch(&patch, &fv, st, jac);
+            return regular_patch(&patch, st, jac);
         }
         if depth >= MAX_DEPTH {
             // Within 2⁻⁴⁰ of a corner that is still irregular: evaluate there.
@@ -257,16 +257,19 @@ fn sub(a: [Real; 2], b: [Real; 2]) -> [Real; 2] {
     [a[0] - b[0], a[1] - b[1]]
 }
 
-/// Evaluates a regular patch: gathers the 4×4 grid (phantoms by reflection)
-/// and maps derivatives from `(s, t)` back to the base `(u, v)`.
-fn regular_patch(patch: &LocalPatch, fv: &[u32], st: [Real; 2], jac: [[Real; 2]; 2]) -> SampleStencil {
-    let level = &patch.level;
-    let f = patch.face as usize;
+/// The 16 control points `P[a][b]` (index `4a + b`, `a` along the face's
+/// `u`) of the bicubic B-spline patch of regular face `f`, as combinations of
+/// the level's vertices. Across a boundary or infinitely sharp edge the
+/// missing row is the reflection `2 P_edge − P_inner`, which reproduces the
+/// boundary and crease rules (the boundary curve is the cubic B-spline of the
+/// boundary vertices); a corner patch reflects both ways.
+///
+/// `f` must be a quad whose corners are all regular ([`corner_kind`]).
+pub(crate) fn patch_grid(level: &Level, sharp: &Sharpness, f: usize) -> [RowBuilder; 16] {
+    let fv = level.face_vertices(f);
     let fe = level.face_edge_list(f);
-    let inf = |e: u32| {
-        patch.sharp.edge[e as usize] >= SHARPNESS_INFINITE || level.is_boundary_edge(e as usize)
-    };
-    let mut grid: Vec<Option<RowBuilder>> = (0..16).map(|_| None).collect();
+    let inf = |e: u32| sharp.edge[e as usize] >= SHARPNESS_INFINITE || level.is_boundary_edge(e as usize);
+    let mut grid: [Option<RowBuilder>; 16] = std::array::from_fn(|_| None);
     let at = |p: [i32; 2]| (4 * p[0] + p[1]) as usize;
     let single = |v: u32| {
         let mut b = RowBuilder::default();
@@ -277,7 +280,7 @@ fn regular_patch(patch: &LocalPatch, fv: &[u32], st: [Real; 2], jac: [[Real; 2];
         grid[at(GRID[k])] = Some(single(fv[k]));
     }
     let add = |g: [i32; 2], o: [i32; 2]| [g[0] + o[0], g[1] + o[1]];
-    let reflect = |grid: &Vec<Option<RowBuilder>>, p: [i32; 2], inner: [i32; 2]| {
+    let reflect = |grid: &[Option<RowBuilder>; 16], p: [i32; 2], inner: [i32; 2]| {
         // 2 P(p) − P(inner)
         let mut b = RowBuilder::default();
         if let (Some(x), Some(y)) = (&grid[at(p)], &grid[at(inner)]) {
@@ -331,16 +334,20 @@ fn regular_patch(patch: &LocalPatch, fv: &[u32], st: [Real; 2], jac: [[Real; 2];
         };
         grid[at(d)] = Some(b);
     }
+    grid.map(|g| g.unwrap_or_default())
+}
+
+/// Evaluates a regular patch and maps derivatives from `(s, t)` back to the base `(u, v)`.
+fn regular_patch(patch: &LocalPatch, st: [Real; 2], jac: [[Real; 2]; 2]) -> SampleStencil {
+    let grid = patch_grid(&patch.level, &patch.sharp, patch.face as usize);
     let w = patch_weights(st[0], st[1]);
     let nc = patch.ncols();
     // Derivatives in (s, t), then chain rule to (u, v).
     let mut local: [Vec<Real>; 6] = std::array::from_fn(|_| vec![0.0; nc]);
-    for (i, g) in grid.iter().enumerate() {
-        if let Some(b) = g {
-            for q in 0..6 {
-                if w[q][i] != 0.0 {
-                    patch.accumulate(b, w[q][i], &mut local[q]);
-                }
+    for (i, b) in grid.iter().enumerate() {
+        for q in 0..6 {
+            if w[q][i] != 0.0 {
+                patch.accumulate(b, w[q][i], &mut local[q]);
             }
         }
     }
