@@ -1,0 +1,34 @@
+//! Reading and writing meshes, point clouds and crease lists.
+//!
+//! Formats: OBJ, PLY (ASCII and binary, either byte order), OFF and XYZ, each
+//! optionally gzip-compressed (`.ply.gz`, `.obj.gz`, …). The format follows the
+//! file extension ([`MeshFormat::from_path`]). Every writer goes through
+//! [`atomic_write`], so a failed write never leaves a half-written file.
+//!
+//! ```no_run
+//! use subdyn::io::{read_mesh, write_mesh};
+//! let cage = read_mesh("cage.obj")?;
+//! write_mesh("cage.ply", &cage, None)?;
+//! # Ok::<(), subdyn::Error>(())
+//! ```
+
+mod atomic;
+mod creases;
+mod format;
+mod obj;
+mod off;
+mod ply;
+mod raw;
+mod read;
+mod source;
+mod text;
+mod write;
+mod xyz;
+
+pub use atomic::atomic_write;
+pub use creases::read_creases;
+pub use format::MeshFormat;
+pub use read::{
+    read_mesh, read_mesh_from_bytes, read_obj_from_bytes, read_points, read_points_from_bytes,
+};
+pub use write::{write_mesh, write_points};
