@@ -2,10 +2,12 @@
 //!
 //! Precompute: the control mesh is refined uniformly to level `L` (default 2);
 //! every level-`L` face whose corners are regular becomes a bicubic B-spline
-//! patch with 16 control points (exactly the limit surface over that face);
-//! the remaining faces, which touch an irregular vertex, are evaluated
-//! exactly through [`LimitEvaluator`]. Each face is sampled on a small grid
-//! and the samples go into a k-d tree.
+//! patch with 16 control points (exactly the limit surface over that face).
+//! A face that touches an irregular vertex is, on first use, subdivided
+//! locally into a quadtree of regular bicubic leaves, [`TREE_DEPTH`] levels
+//! deep; only the innermost cell at the irregular vertex is evaluated through
+//! [`LimitEvaluator`]. Each face is sampled on a small grid and the samples go
+//! into a k-d tree.
 //!
 //! Query: the nearest samples seed a projected Newton iteration on
 //! `½‖P(s, t) − q‖²` inside a level-`L` face, with a Gauss-Newton fallback
@@ -14,6 +16,7 @@
 //! The result is reported as a base-face sample `(face, u, v)`.
 
 use std::num::NonZero;
+use std::sync::OnceLock;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
@@ -24,7 +27,7 @@ use crate::subdivision::{Hierarchy, Refiner};
 use crate::topology::{Level, NONE};
 
 use super::bspline::patch_weights;
-use super::patch::patch_grid;
+use super::patch::{CORNERS, LocalPatch, patch_grid};
 use super::vertex_masks::{CornerKind, corner_kind};
 use super::{LimitEvaluator, Sample};
 
@@ -65,14 +68,28 @@ pub struct ClosestPoint {
     pub normal: Vector3,
 }
 
+/// Levels of local subdivision below `L` for faces at irregular vertices.
+pub const TREE_DEPTH: usize = 8;
+
 /// A level-`L` face: its limit patch and its place in its base face.
 struct Patch {
     /// Control points of the bicubic patch, or `None` near an irregular vertex.
     grid: Option<[Point3; 16]>,
+    /// Regular leaves of the local subdivision of an irregular face (lazy).
+    tree: OnceLock<Vec<Leaf>>,
     base: u32,
     /// Base `(u, v) = origin + axes · (s, t)`.
     origin: [Real; 2],
     axes: [[Real; 2]; 2],
+}
+
+/// A cell of an irregular face's quadtree: leaf `(s', t') = J (s, t) + c`
+/// in the face's `(s, t)`, with its bicubic control points (`None` for the
+/// innermost cell at an irregular vertex, evaluated exactly).
+struct Leaf {
+    jac: [[Real; 2]; 2],
+    off: [Real; 2],
+    grid: Option<[Point3; 16]>,
 }
 
 /// Position and first/second derivatives in a patch's own `(s, t)`.
@@ -86,6 +103,8 @@ pub struct ClosestPointEngine {
     evaluator: LimitEvaluator,
     positions: Vec<Point3>,
     level: Level,
+    sharp: crate::topology::Sharpness,
+    level_positions: Vec<Point3>,
     patches: Vec<Patch>,
     seeds: Vec<(u32, [Real; 2])>,
     tree: ImmutableKdTree<Real, 3>,
@@ -93,7 +112,6 @@ pub struct ClosestPointEngine {
     scale: Real,
 }
 
-const CORNERS: [[Real; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
 
 impl ClosestPointEngine {
     /// Precomputes patches and the seed tree for control points `positions`.
@@ -141,6 +159,7 @@ impl ClosestPointEngine {
                 let (base, origin, axes) = maps[f];
                 Patch {
                     grid,
+                    tree: OnceLock::new(),
                     base,
                     origin,
                     axes,
@@ -151,6 +170,8 @@ impl ClosestPointEngine {
             evaluator,
             positions: positions.to_vec(),
             level: fine.clone(),
+            sharp: sharp.clone(),
+            level_positions: lp.clone(),
             patches,
             seeds: Vec::new(),
             tree: ImmutableKdTree::new_from_slice(&[[0.0; 3]]),
@@ -185,6 +206,34 @@ impl ClosestPointEngine {
             return Ok(Eval {
                 p: Point3::from(q[0]),
                 d: [q[1], q[2], q[3], q[4], q[5]],
+            });
+        }
+        let leaves = patch.tree.get_or_init(|| self.leaves(f));
+        let inside = |l: &&Leaf| {
+            let x = l.jac[0][0] * st[0] + l.jac[0][1] * st[1] + l.off[0];
+            let y = l.jac[1][0] * st[0] + l.jac[1][1] * st[1] + l.off[1];
+            (-1e-12..=1.0 + 1e-12).contains(&x) && (-1e-12..=1.0 + 1e-12).contains(&y)
+        };
+        if let Some(leaf) = leaves.iter().filter(|l| l.grid.is_some()).find(inside) {
+            let j = leaf.jac;
+            let x = [
+                (j[0][0] * st[0] + j[0][1] * st[1] + leaf.off[0]).clamp(0.0, 1.0),
+                (j[1][0] * st[0] + j[1][1] * st[1] + leaf.off[1]).clamp(0.0, 1.0),
+            ];
+            let grid = leaf.grid.as_ref().expect("filtered");
+            let w = patch_weights(x[0], x[1]);
+            let q: [Vector3; 6] = std::array::from_fn(|k| (0..16).map(|i| w[k][i] * grid[i].coords).sum());
+            // (s', t') = J (s, t) + c: first and second derivatives by the chain rule.
+            let (su, sv, tu, tv) = (j[0][0], j[0][1], j[1][0], j[1][1]);
+            return Ok(Eval {
+                p: Point3::from(q[0]),
+                d: [
+                    q[1] * su + q[2] * tu,
+                    q[1] * sv + q[2] * tv,
+                    q[3] * su * su + q[4] * (2.0 * su * tu) + q[5] * tu * tu,
+                    q[3] * su * sv + q[4] * (su * tv + sv * tu) + q[5] * tu * tv,
+                    q[3] * sv * sv + q[4] * (2.0 * sv * tv) + q[5] * tv * tv,
+                ],
             });
         }
         let a = patch.axes;
@@ -238,6 +287,50 @@ impl ClosestPointEngine {
             distance: d,
             normal,
         })
+    }
+
+    /// Quadtree leaves of irregular level-`L` face `f` (see module docs).
+    fn leaves(&self, f: usize) -> Vec<Leaf> {
+        let positions = |rows: [Vec<Real>; 16], cols: &[u32]| -> [Point3; 16] {
+            rows.map(|r| {
+                Point3::from(
+                    r.iter()
+                        .zip(cols)
+                        .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
+                        .sum::<Vector3>(),
+                )
+            })
+        };
+        let mut leaves = Vec::new();
+        let mut stack = vec![(LocalPatch::around(&self.level, &self.sharp, f), [[1.0, 0.0], [0.0, 1.0]], [0.0, 0.0], 0)];
+        while let Some((patch, jac, off, depth)) = stack.pop() {
+            if depth == TREE_DEPTH {
+                leaves.push(Leaf { jac, off, grid: None });
+                continue;
+            }
+            let refined = patch.refined();
+            for k in 0..4 {
+                // Child k: corner 0 at corner k, s' towards corner k+1, t' towards k−1.
+                let o = CORNERS[k];
+                let a = [CORNERS[(k + 1) % 4][0] - o[0], CORNERS[(k + 1) % 4][1] - o[1]];
+                let b = [CORNERS[(k + 3) % 4][0] - o[0], CORNERS[(k + 3) % 4][1] - o[1]];
+                let m = [[2.0 * a[0], 2.0 * a[1]], [2.0 * b[0], 2.0 * b[1]]];
+                let cj = [
+                    [m[0][0] * jac[0][0] + m[0][1] * jac[1][0], m[0][0] * jac[0][1] + m[0][1] * jac[1][1]],
+                    [m[1][0] * jac[0][0] + m[1][1] * jac[1][0], m[1][0] * jac[0][1] + m[1][1] * jac[1][1]],
+                ];
+                let d = [off[0] - o[0], off[1] - o[1]];
+                let co = [m[0][0] * d[0] + m[0][1] * d[1], m[1][0] * d[0] + m[1][1] * d[1]];
+                let cf = patch.child_face(k);
+                if refined.is_regular(cf) {
+                    let grid = positions(refined.grid_rows(cf), &refined.cols);
+                    leaves.push(Leaf { jac: cj, off: co, grid: Some(grid) });
+                } else {
+                    stack.push((refined.extract(cf), cj, co, depth + 1));
+                }
+            }
+        }
+        leaves
     }
 
     /// Closest points of many queries, in parallel.

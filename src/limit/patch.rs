@@ -41,19 +41,19 @@ pub struct SampleStencil {
 
 /// A neighbourhood of one face, with every local vertex as a dense row of
 /// weights over `cols`.
-struct LocalPatch {
-    level: Level,
+pub(crate) struct LocalPatch {
+    pub(crate) level: Level,
     sharp: Sharpness,
-    cols: Vec<u32>,
+    pub(crate) cols: Vec<u32>,
     /// `level.num_vertices × cols.len()`, row-major.
     rows: Vec<Real>,
     /// Local index of the face being followed.
-    face: u32,
+    pub(crate) face: u32,
 }
 
 impl LocalPatch {
     /// The 1-ring of `face` in `level`, with identity rows over its vertices.
-    fn around(level: &Level, sharp: &Sharpness, face: usize) -> LocalPatch {
+    pub(crate) fn around(level: &Level, sharp: &Sharpness, face: usize) -> LocalPatch {
         let (sub, map) = one_ring(level, sharp, face);
         let n = map.len();
         let mut rows = vec![0.0; n * n];
@@ -76,15 +76,24 @@ impl LocalPatch {
     /// Subdivides once and keeps the 1-ring of the child of the current face
     /// at corner `k`.
     fn descend(&mut self, k: usize) {
+        let r = self.refined();
+        *self = r.extract(self.child_face(k));
+    }
+
+    /// The local child face of the current face at corner `k` (in [`refined`](Self::refined)).
+    pub(crate) fn child_face(&self, k: usize) -> u32 {
+        self.level.face_offsets[self.face as usize] + k as u32
+    }
+
+    /// The whole neighbourhood subdivided once (rows for every child vertex);
+    /// its `face` is the child at corner 0.
+    pub(crate) fn refined(&self) -> LocalPatch {
         let child = refine_topology(&self.level);
         let (s, child_sharp) = refine_stencil(&self.level, &self.sharp, &child);
-        let cface = self.level.face_offsets[self.face as usize] as usize + k;
-        let (sub, map) = one_ring(&child, &child_sharp, cface);
         let nc = self.ncols();
-        let mut rows = vec![0.0; map.len() * nc];
-        for (i, &cv) in map.iter().enumerate() {
-            let (idx, w) = s.row(cv as usize);
-            let out = &mut rows[i * nc..(i + 1) * nc];
+        let mut rows = vec![0.0; child.num_vertices * nc];
+        for (cv, out) in rows.chunks_mut(nc.max(1)).enumerate().take(child.num_vertices) {
+            let (idx, w) = s.row(cv);
             for (&p, &w) in idx.iter().zip(w) {
                 let src = &self.rows[p as usize * nc..(p as usize + 1) * nc];
                 for (o, &x) in out.iter_mut().zip(src) {
@@ -92,10 +101,49 @@ impl LocalPatch {
                 }
             }
         }
-        self.level = sub.0;
-        self.sharp = sub.1;
-        self.rows = rows;
-        self.face = sub.2;
+        LocalPatch {
+            face: self.child_face(0),
+            level: child,
+            sharp: child_sharp,
+            cols: self.cols.clone(),
+            rows,
+        }
+    }
+
+    /// The 1-ring of local face `face`, as a patch of its own.
+    pub(crate) fn extract(&self, face: u32) -> LocalPatch {
+        let (sub, map) = one_ring(&self.level, &self.sharp, face as usize);
+        let nc = self.ncols();
+        let mut rows = Vec::with_capacity(map.len() * nc);
+        for &v in &map {
+            rows.extend_from_slice(&self.rows[v as usize * nc..(v as usize + 1) * nc]);
+        }
+        LocalPatch {
+            level: sub.0,
+            sharp: sub.1,
+            cols: self.cols.clone(),
+            rows,
+            face: sub.2,
+        }
+    }
+
+    /// True when every corner of local face `f` is regular.
+    pub(crate) fn is_regular(&self, f: u32) -> bool {
+        self.level
+            .face_vertices(f as usize)
+            .iter()
+            .all(|&c| corner_kind(&self.level, &self.sharp, c as usize, f) != CornerKind::Irregular)
+    }
+
+    /// The 16 B-spline control points of regular local face `f`, as dense
+    /// rows over `cols`.
+    pub(crate) fn grid_rows(&self, f: u32) -> [Vec<Real>; 16] {
+        let grid = patch_grid(&self.level, &self.sharp, f as usize);
+        std::array::from_fn(|i| {
+            let mut out = vec![0.0; self.ncols()];
+            self.accumulate(&grid[i], 1.0, &mut out);
+            out
+        })
     }
 
     /// Adds `scale ×` the row of local vertex-combination `b` into `out`.
@@ -157,7 +205,7 @@ fn one_ring(level: &Level, sharp: &Sharpness, face: usize) -> ((Level, Sharpness
 }
 
 /// Parameter position of corner `k` of a quad.
-const CORNERS: [[Real; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+pub(crate) const CORNERS: [[Real; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
 /// Outward direction of quad edge `k` in the 4×4 grid.
 const OUT: [[i32; 2]; 4] = [[0, -1], [1, 0], [0, 1], [-1, 0]];
 /// Grid position of quad corner `k`.
