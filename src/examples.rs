@@ -35,7 +35,9 @@ pub fn torus(n: usize, m: usize, r_major: f64, r_minor: f64) -> PolyMesh {
     }
     let id = |i: usize, j: usize| ((i % n) * m + (j % m)) as u32;
     let faces: Vec<Vec<u32>> = (0..n)
-        .flat_map(|i| (0..m).map(move |j| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]))
+        .flat_map(|i| {
+            (0..m).map(move |j| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
+        })
         .collect();
     PolyMesh::from_faces(positions, &faces).expect("the torus is valid")
 }

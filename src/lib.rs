@@ -11,7 +11,7 @@
 //! let hierarchy = refiner.refine_uniform(2).unwrap();       // levels + stencils S_k
 //! let s = hierarchy.stencil_to_level(2).unwrap();           // P_2 = S P_0, one CSR table
 //! let p2 = s.apply(&cage.positions).unwrap();               // one sparse product
-//! assert_eq!(p2.len(), hierarchy.level(2).num_vertices());
+//! assert_eq!(p2.len(), hierarchy.level(2).num_vertices);
 //! # let _ = io::MeshFormat::Obj;
 //! ```
 //!

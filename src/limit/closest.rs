@@ -112,10 +112,13 @@ pub struct ClosestPointEngine {
     scale: Real,
 }
 
-
 impl ClosestPointEngine {
     /// Precomputes patches and the seed tree for control points `positions`.
-    pub fn new(refiner: &Refiner, positions: &[Point3], params: &ClosestPointParams) -> Result<Self> {
+    pub fn new(
+        refiner: &Refiner,
+        positions: &[Point3],
+        params: &ClosestPointParams,
+    ) -> Result<Self> {
         if params.level == 0 || params.level > 6 {
             return Err(Error::Input(format!(
                 "closest-point level {} must be between 1 and 6",
@@ -147,13 +150,16 @@ impl ClosestPointEngine {
         let patches: Vec<Patch> = (0..fine.num_faces())
             .into_par_iter()
             .map(|f| {
-                let regular = fine
-                    .face_vertices(f)
-                    .iter()
-                    .all(|&c| corner_kind(fine, sharp, c as usize, f as u32) != CornerKind::Irregular);
+                let regular = fine.face_vertices(f).iter().all(|&c| {
+                    corner_kind(fine, sharp, c as usize, f as u32) != CornerKind::Irregular
+                });
                 let grid = regular.then(|| {
                     patch_grid(fine, sharp, f).map(|b| {
-                        Point3::from(b.entries().map(|(c, w)| w * lp[c as usize].coords).sum::<Vector3>())
+                        Point3::from(
+                            b.entries()
+                                .map(|(c, w)| w * lp[c as usize].coords)
+                                .sum::<Vector3>(),
+                        )
                     })
                 });
                 let (base, origin, axes) = maps[f];
@@ -202,7 +208,8 @@ impl ClosestPointEngine {
         let patch = &self.patches[f];
         if let Some(grid) = &patch.grid {
             let w = patch_weights(st[0], st[1]);
-            let q: [Vector3; 6] = std::array::from_fn(|k| (0..16).map(|i| w[k][i] * grid[i].coords).sum());
+            let q: [Vector3; 6] =
+                std::array::from_fn(|k| (0..16).map(|i| w[k][i] * grid[i].coords).sum());
             return Ok(Eval {
                 p: Point3::from(q[0]),
                 d: [q[1], q[2], q[3], q[4], q[5]],
@@ -222,7 +229,8 @@ impl ClosestPointEngine {
             ];
             let grid = leaf.grid.as_ref().expect("filtered");
             let w = patch_weights(x[0], x[1]);
-            let q: [Vector3; 6] = std::array::from_fn(|k| (0..16).map(|i| w[k][i] * grid[i].coords).sum());
+            let q: [Vector3; 6] =
+                std::array::from_fn(|k| (0..16).map(|i| w[k][i] * grid[i].coords).sum());
             // (s', t') = J (s, t) + c: first and second derivatives by the chain rule.
             let (su, sv, tu, tv) = (j[0][0], j[0][1], j[1][0], j[1][1]);
             return Ok(Eval {
@@ -239,7 +247,9 @@ impl ClosestPointEngine {
         let a = patch.axes;
         let u = patch.origin[0] + a[0][0] * st[0] + a[0][1] * st[1];
         let v = patch.origin[1] + a[1][0] * st[0] + a[1][1] * st[1];
-        let e = self.evaluator.evaluate(patch.base as usize, u, v, &self.positions)?;
+        let e = self
+            .evaluator
+            .evaluate(patch.base as usize, u, v, &self.positions)?;
         // (u, v) = o + A (s, t): chain rule.
         let (us, ut, vs, vt) = (a[0][0], a[0][1], a[1][0], a[1][1]);
         Ok(Eval {
@@ -257,9 +267,13 @@ impl ClosestPointEngine {
     /// The closest limit-surface point to `q`.
     pub fn closest_point(&self, q: Point3) -> Result<ClosestPoint> {
         if !q.coords.iter().all(|c| c.is_finite()) {
-            return Err(Error::Input(format!("query point ({}, {}, {}) is not finite", q.x, q.y, q.z)));
+            return Err(Error::Input(format!(
+                "query point ({}, {}, {}) is not finite",
+                q.x, q.y, q.z
+            )));
         }
-        let k = NonZero::new(self.params.candidates.min(self.seeds.len())).unwrap_or(NonZero::<usize>::MIN);
+        let k = NonZero::new(self.params.candidates.min(self.seeds.len()))
+            .unwrap_or(NonZero::<usize>::MIN);
         let near = self.tree.nearest_n::<SquaredEuclidean>(&[q.x, q.y, q.z], k);
         let mut best: Option<(Real, usize, [Real; 2], Eval)> = None;
         for nn in near {
@@ -276,7 +290,9 @@ impl ClosestPointEngine {
         let n = e.d[0].cross(&e.d[1]);
         // Orientation of (s, t) relative to (u, v) decides the normal's sign.
         let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-        let normal = (n * det.signum()).try_normalize(0.0).unwrap_or_else(Vector3::zeros);
+        let normal = (n * det.signum())
+            .try_normalize(0.0)
+            .unwrap_or_else(Vector3::zeros);
         Ok(ClosestPoint {
             sample: Sample {
                 face: p.base,
@@ -302,29 +318,57 @@ impl ClosestPointEngine {
             })
         };
         let mut leaves = Vec::new();
-        let mut stack = vec![(LocalPatch::around(&self.level, &self.sharp, f), [[1.0, 0.0], [0.0, 1.0]], [0.0, 0.0], 0)];
+        let mut stack = vec![(
+            LocalPatch::around(&self.level, &self.sharp, f),
+            [[1.0, 0.0], [0.0, 1.0]],
+            [0.0, 0.0],
+            0,
+        )];
         while let Some((patch, jac, off, depth)) = stack.pop() {
             if depth == TREE_DEPTH {
-                leaves.push(Leaf { jac, off, grid: None });
+                leaves.push(Leaf {
+                    jac,
+                    off,
+                    grid: None,
+                });
                 continue;
             }
             let refined = patch.refined();
             for k in 0..4 {
                 // Child k: corner 0 at corner k, s' towards corner k+1, t' towards k−1.
                 let o = CORNERS[k];
-                let a = [CORNERS[(k + 1) % 4][0] - o[0], CORNERS[(k + 1) % 4][1] - o[1]];
-                let b = [CORNERS[(k + 3) % 4][0] - o[0], CORNERS[(k + 3) % 4][1] - o[1]];
+                let a = [
+                    CORNERS[(k + 1) % 4][0] - o[0],
+                    CORNERS[(k + 1) % 4][1] - o[1],
+                ];
+                let b = [
+                    CORNERS[(k + 3) % 4][0] - o[0],
+                    CORNERS[(k + 3) % 4][1] - o[1],
+                ];
                 let m = [[2.0 * a[0], 2.0 * a[1]], [2.0 * b[0], 2.0 * b[1]]];
                 let cj = [
-                    [m[0][0] * jac[0][0] + m[0][1] * jac[1][0], m[0][0] * jac[0][1] + m[0][1] * jac[1][1]],
-                    [m[1][0] * jac[0][0] + m[1][1] * jac[1][0], m[1][0] * jac[0][1] + m[1][1] * jac[1][1]],
+                    [
+                        m[0][0] * jac[0][0] + m[0][1] * jac[1][0],
+                        m[0][0] * jac[0][1] + m[0][1] * jac[1][1],
+                    ],
+                    [
+                        m[1][0] * jac[0][0] + m[1][1] * jac[1][0],
+                        m[1][0] * jac[0][1] + m[1][1] * jac[1][1],
+                    ],
                 ];
                 let d = [off[0] - o[0], off[1] - o[1]];
-                let co = [m[0][0] * d[0] + m[0][1] * d[1], m[1][0] * d[0] + m[1][1] * d[1]];
+                let co = [
+                    m[0][0] * d[0] + m[0][1] * d[1],
+                    m[1][0] * d[0] + m[1][1] * d[1],
+                ];
                 let cf = patch.child_face(k);
                 if refined.is_regular(cf) {
                     let grid = positions(refined.grid_rows(cf), &refined.cols);
-                    leaves.push(Leaf { jac: cj, off: co, grid: Some(grid) });
+                    leaves.push(Leaf {
+                        jac: cj,
+                        off: co,
+                        grid: Some(grid),
+                    });
                 } else {
                     stack.push((refined.extract(cf), cj, co, depth + 1));
                 }
@@ -339,7 +383,12 @@ impl ClosestPointEngine {
     }
 
     /// Projected Newton descent from `(f, st)`, crossing into neighbouring patches.
-    fn descend(&self, q: Point3, mut f: usize, mut st: [Real; 2]) -> Result<(usize, [Real; 2], Eval)> {
+    fn descend(
+        &self,
+        q: Point3,
+        mut f: usize,
+        mut st: [Real; 2],
+    ) -> Result<(usize, [Real; 2], Eval)> {
         let mut e = self.eval(f, st)?;
         let mut crossings = 0;
         let tol = 1e-13;
@@ -349,7 +398,11 @@ impl ClosestPointEngine {
             let g = [ps.dot(&r), pt.dot(&r)];
             // Newton Hessian, Gauss-Newton if not positive definite.
             let gn = [ps.dot(&ps), ps.dot(&pt), pt.dot(&pt)];
-            let nh = [gn[0] + e.d[2].dot(&r), gn[1] + e.d[3].dot(&r), gn[2] + e.d[4].dot(&r)];
+            let nh = [
+                gn[0] + e.d[2].dot(&r),
+                gn[1] + e.d[3].dot(&r),
+                gn[2] + e.d[4].dot(&r),
+            ];
             let step = solve_spd(nh, g).or_else(|| solve_spd(gn, g));
             let Some(mut step) = step else { break };
             // Limit the step to half a patch.
@@ -381,7 +434,10 @@ impl ClosestPointEngine {
             let mut accepted = None;
             let mut a = alpha;
             for _ in 0..20 {
-                let cand = [(st[0] + a * step[0]).clamp(0.0, 1.0), (st[1] + a * step[1]).clamp(0.0, 1.0)];
+                let cand = [
+                    (st[0] + a * step[0]).clamp(0.0, 1.0),
+                    (st[1] + a * step[1]).clamp(0.0, 1.0),
+                ];
                 let ce = self.eval(f, cand)?;
                 if (ce.p - q).norm_squared() <= d0 {
                     accepted = Some((cand, ce, a));
@@ -393,16 +449,16 @@ impl ClosestPointEngine {
             let moved = ((cand[0] - st[0]).powi(2) + (cand[1] - st[1]).powi(2)).sqrt();
             st = cand;
             e = ce;
-            if a == alpha && alpha < 1.0 && crossings < 16 {
-                if let Some(k) = side {
-                    if let Some((g, gst)) = self.across(f, k, st) {
-                        f = g;
-                        st = gst;
-                        e = self.eval(f, st)?;
-                        crossings += 1;
-                        continue;
-                    }
-                }
+            if a == alpha
+                && alpha < 1.0
+                && crossings < 16
+                && let Some((g, gst)) = side.and_then(|k| self.across(f, k, st))
+            {
+                f = g;
+                st = gst;
+                e = self.eval(f, st)?;
+                crossings += 1;
+                continue;
             }
             if moved < tol {
                 break;
@@ -432,7 +488,13 @@ impl ClosestPointEngine {
         // In g the edge runs the other way.
         let sigma = 1.0 - tau;
         let (d0, d1) = (CORNERS[j], CORNERS[(j + 1) % 4]);
-        Some((g, [d0[0] + sigma * (d1[0] - d0[0]), d0[1] + sigma * (d1[1] - d0[1])]))
+        Some((
+            g,
+            [
+                d0[0] + sigma * (d1[0] - d0[0]),
+                d0[1] + sigma * (d1[1] - d0[1]),
+            ],
+        ))
     }
 
     /// Bounding-box diagonal of the control points (the scale of distances).
@@ -447,35 +509,56 @@ fn solve_spd(h: [Real; 3], g: [Real; 2]) -> Option<[Real; 2]> {
     if !(h[0] > 0.0 && det > 1e-300 * (h[0] * h[2]).abs().max(1e-300)) {
         return None;
     }
-    Some([(-g[0] * h[2] + g[1] * h[1]) / det, (g[0] * h[1] - g[1] * h[0]) / det])
+    Some([
+        (-g[0] * h[2] + g[1] * h[1]) / det,
+        (g[0] * h[1] - g[1] * h[0]) / det,
+    ])
 }
 
 /// For every face of the finest level: its base face and the affine map from
 /// its `(s, t)` to the base face's `(u, v)`.
 fn param_maps(h: &Hierarchy) -> Vec<(u32, [Real; 2], [[Real; 2]; 2])> {
     let l0 = h.level(0);
-    let mut maps: Vec<(u32, [Real; 2], [[Real; 2]; 2])> =
-        (0..l0.num_faces() as u32).map(|f| (f, [0.0, 0.0], [[1.0, 0.0], [0.0, 1.0]])).collect();
+    let mut maps: Vec<(u32, [Real; 2], [[Real; 2]; 2])> = (0..l0.num_faces() as u32)
+        .map(|f| (f, [0.0, 0.0], [[1.0, 0.0], [0.0, 1.0]]))
+        .collect();
     for k in 0..h.num_levels() {
         let parent = h.level(k);
         let mut next = Vec::with_capacity(parent.face_verts.len());
-        for f in 0..parent.num_faces() {
+        for (f, &(base, o, a)) in maps.iter().enumerate() {
             let n = parent.face_vertices(f).len();
-            let (base, o, a) = maps[f];
             for i in 0..n {
                 if n != 4 {
                     // n-gon sub-face i: its tile, at half scale (only at level 0).
                     let d = (n as Real).sqrt().ceil() as usize;
-                    next.push((base, [(i % d) as Real, (i / d) as Real], [[0.5, 0.0], [0.0, 0.5]]));
+                    next.push((
+                        base,
+                        [(i % d) as Real, (i / d) as Real],
+                        [[0.5, 0.0], [0.0, 0.5]],
+                    ));
                     continue;
                 }
                 // Child i: corner 0 at parent corner i, s towards i+1, t towards i−1.
                 let c = CORNERS[i];
-                let ax = [CORNERS[(i + 1) % 4][0] - c[0], CORNERS[(i + 1) % 4][1] - c[1]];
-                let bx = [CORNERS[(i + 3) % 4][0] - c[0], CORNERS[(i + 3) % 4][1] - c[1]];
+                let ax = [
+                    CORNERS[(i + 1) % 4][0] - c[0],
+                    CORNERS[(i + 1) % 4][1] - c[1],
+                ];
+                let bx = [
+                    CORNERS[(i + 3) % 4][0] - c[0],
+                    CORNERS[(i + 3) % 4][1] - c[1],
+                ];
                 // parent (s, t) = c + ½ (ax s' + bx t'); base = o + a · parent.
-                let po = [o[0] + a[0][0] * c[0] + a[0][1] * c[1], o[1] + a[1][0] * c[0] + a[1][1] * c[1]];
-                let col = |v: [Real; 2]| [0.5 * (a[0][0] * v[0] + a[0][1] * v[1]), 0.5 * (a[1][0] * v[0] + a[1][1] * v[1])];
+                let po = [
+                    o[0] + a[0][0] * c[0] + a[0][1] * c[1],
+                    o[1] + a[1][0] * c[0] + a[1][1] * c[1],
+                ];
+                let col = |v: [Real; 2]| {
+                    [
+                        0.5 * (a[0][0] * v[0] + a[0][1] * v[1]),
+                        0.5 * (a[1][0] * v[0] + a[1][1] * v[1]),
+                    ]
+                };
                 let (cs, ct) = (col(ax), col(bx));
                 next.push((base, po, [[cs[0], ct[0]], [cs[1], ct[1]]]));
             }

@@ -45,7 +45,10 @@ pub struct LimitPoint {
 impl LimitPoint {
     /// Unit normal `Pu × Pv / |Pu × Pv|` (zero if the derivatives are parallel).
     pub fn normal(&self) -> Vector3 {
-        self.du.cross(&self.dv).try_normalize(0.0).unwrap_or_else(Vector3::zeros)
+        self.du
+            .cross(&self.dv)
+            .try_normalize(0.0)
+            .unwrap_or_else(Vector3::zeros)
     }
 }
 
@@ -127,7 +130,11 @@ impl LimitEvaluator {
         } else {
             (n as Real).sqrt().ceil() - 0.5
         };
-        if !(u.is_finite() && v.is_finite() && (0.0..=umax).contains(&u) && (0.0..=umax).contains(&v)) {
+        if !(u.is_finite()
+            && v.is_finite()
+            && (0.0..=umax).contains(&u)
+            && (0.0..=umax).contains(&v))
+        {
             return Err(Error::Input(format!(
                 "parameter ({u}, {v}) of face {face} outside [0, {umax}]²"
             )));
@@ -136,7 +143,13 @@ impl LimitEvaluator {
     }
 
     /// Position and derivatives at `(face, u, v)` for control points `positions`.
-    pub fn evaluate(&self, face: usize, u: Real, v: Real, positions: &[Point3]) -> Result<LimitPoint> {
+    pub fn evaluate(
+        &self,
+        face: usize,
+        u: Real,
+        v: Real,
+        positions: &[Point3],
+    ) -> Result<LimitPoint> {
         if positions.len() != self.num_control_points() {
             return Err(Error::Input(format!(
                 "{} control points given for a mesh of {}",

@@ -19,7 +19,9 @@ use crate::subdivision::{refine_stencil, refine_topology};
 use crate::topology::{Level, SHARPNESS_INFINITE, Sharpness, find_edge};
 
 use super::bspline::patch_weights;
-use super::vertex_masks::{CornerKind, corner_kind, corner_tangents, limit_position_mask, masks_apply};
+use super::vertex_masks::{
+    CornerKind, corner_kind, corner_tangents, limit_position_mask, masks_apply,
+};
 
 /// Deepest local subdivision; a point within `2⁻⁴⁰` of an irregular corner
 /// is evaluated at the corner.
@@ -92,7 +94,11 @@ impl LocalPatch {
         let (s, child_sharp) = refine_stencil(&self.level, &self.sharp, &child);
         let nc = self.ncols();
         let mut rows = vec![0.0; child.num_vertices * nc];
-        for (cv, out) in rows.chunks_mut(nc.max(1)).enumerate().take(child.num_vertices) {
+        for (cv, out) in rows
+            .chunks_mut(nc.max(1))
+            .enumerate()
+            .take(child.num_vertices)
+        {
             let (idx, w) = s.row(cv);
             for (&p, &w) in idx.iter().zip(w) {
                 let src = &self.rows[p as usize * nc..(p as usize + 1) * nc];
@@ -217,7 +223,13 @@ const GRID: [[i32; 2]; 4] = [[1, 1], [2, 1], [2, 2], [1, 2]];
 /// `i`, the centroid, the midpoint of edge `i − 1`) occupies
 /// `[tu, tu + ½] × [tv, tv + ½]` with tile `(tu, tv) = (i mod d, i div d)`,
 /// `d = ⌈√n⌉` (OpenSubdiv `Bfr`'s quad-subface parameterisation).
-pub fn evaluate_face(level: &Level, sharp: &Sharpness, face: usize, u: Real, v: Real) -> SampleStencil {
+pub fn evaluate_face(
+    level: &Level,
+    sharp: &Sharpness,
+    face: usize,
+    u: Real,
+    v: Real,
+) -> SampleStencil {
     let mut patch = LocalPatch::around(level, sharp, face);
     let n = level.face_vertices(face).len();
     // (s, t) = a · (u, v) + offset with a = jac (2×2), tracked for the chain rule.
@@ -316,7 +328,8 @@ fn sub(a: [Real; 2], b: [Real; 2]) -> [Real; 2] {
 pub(crate) fn patch_grid(level: &Level, sharp: &Sharpness, f: usize) -> [RowBuilder; 16] {
     let fv = level.face_vertices(f);
     let fe = level.face_edge_list(f);
-    let inf = |e: u32| sharp.edge[e as usize] >= SHARPNESS_INFINITE || level.is_boundary_edge(e as usize);
+    let inf =
+        |e: u32| sharp.edge[e as usize] >= SHARPNESS_INFINITE || level.is_boundary_edge(e as usize);
     let mut grid: [Option<RowBuilder>; 16] = std::array::from_fn(|_| None);
     let at = |p: [i32; 2]| (4 * p[0] + p[1]) as usize;
     let single = |v: u32| {
@@ -374,7 +387,11 @@ pub(crate) fn patch_grid(level: &Level, sharp: &Sharpness, f: usize) -> [RowBuil
         } else {
             // Smooth valence-4 corner: the face opposite in the ring.
             let ring = level.vertex_ring(fv[k] as usize);
-            let i = ring.faces.iter().position(|&x| x as usize == f).unwrap_or(0);
+            let i = ring
+                .faces
+                .iter()
+                .position(|&x| x as usize == f)
+                .unwrap_or(0);
             let opp = ring.faces[(i + 2) % ring.faces.len()] as usize;
             let ov = level.face_vertices(opp);
             let j = ov.iter().position(|&x| x == fv[k]).unwrap_or(0);

@@ -59,9 +59,15 @@ struct Tile {
 /// the same number of samples. Samples on shared edges and vertices are
 /// shared, so a closed control mesh gives a watertight tessellation. Returns
 /// the mesh and one unit normal per vertex (`Pu × Pv`).
-pub fn tessellate(refiner: &Refiner, positions: &[Point3], k: usize) -> Result<(PolyMesh, Vec<Vector3>)> {
+pub fn tessellate(
+    refiner: &Refiner,
+    positions: &[Point3],
+    k: usize,
+) -> Result<(PolyMesh, Vec<Vector3>)> {
     if k == 0 || k > 1024 {
-        return Err(Error::Input(format!("tessellation rate {k} must be between 1 and 1024")));
+        return Err(Error::Input(format!(
+            "tessellation rate {k} must be between 1 and 1024"
+        )));
     }
     let level = &refiner.level;
     if positions.len() != level.num_vertices {

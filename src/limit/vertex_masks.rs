@@ -54,8 +54,14 @@ fn is_inf(level: &Level, sharp: &Sharpness, e: usize) -> bool {
 pub fn masks_apply(level: &Level, sharp: &Sharpness, v: usize) -> bool {
     let semi = |s: Real| s > 0.0 && s < SHARPNESS_INFINITE;
     !semi(sharp.vertex[v])
-        && level.vertex_edges(v).iter().all(|&e| !semi(sharp.edge[e as usize]))
-        && level.vertex_faces(v).iter().all(|&f| level.face_vertices(f as usize).len() == 4)
+        && level
+            .vertex_edges(v)
+            .iter()
+            .all(|&e| !semi(sharp.edge[e as usize]))
+        && level
+            .vertex_faces(v)
+            .iter()
+            .all(|&f| level.face_vertices(f as usize).len() == 4)
 }
 
 /// Number of faces in the sector of `ring` that holds `ring.faces[i]`,
@@ -132,7 +138,13 @@ fn ring_points(level: &Level, ring: &VertexRing, v: u32) -> (Vec<u32>, Vec<u32>)
 
 /// Adds `scale ×` the exact limit-position mask of `v`. Requires
 /// [`masks_apply`]; isolated vertices map to themselves.
-pub fn limit_position_mask(level: &Level, sharp: &Sharpness, v: usize, scale: Real, b: &mut RowBuilder) {
+pub fn limit_position_mask(
+    level: &Level,
+    sharp: &Sharpness,
+    v: usize,
+    scale: Real,
+    b: &mut RowBuilder,
+) {
     let v32 = v as u32;
     if level.vertex_faces(v).is_empty() {
         b.add(v32, scale);
@@ -169,7 +181,12 @@ pub fn limit_position_mask(level: &Level, sharp: &Sharpness, v: usize, scale: Re
 /// trailing edge (towards the previous corner); the parametric derivative
 /// along each edge is `3 T` per unit of the sub-patch parameter (module docs).
 /// Requires [`masks_apply`].
-pub fn corner_tangents(level: &Level, sharp: &Sharpness, v: usize, f: u32) -> (RowBuilder, RowBuilder) {
+pub fn corner_tangents(
+    level: &Level,
+    sharp: &Sharpness,
+    v: usize,
+    f: u32,
+) -> (RowBuilder, RowBuilder) {
     let v32 = v as u32;
     let ring = level.vertex_ring(v);
     let (e, fp) = ring_points(level, &ring, v32);
@@ -228,8 +245,8 @@ pub fn corner_tangents(level: &Level, sharp: &Sharpness, v: usize, f: u32) -> (R
     t_int.add(v32, -4.0 * s / den / 3.0);
     t_int.add(ee[0], alpha / 3.0);
     t_int.add(ee[k], alpha / 3.0);
-    for j in 1..k {
-        t_int.add(ee[j], 4.0 * (j as Real * theta).sin() / den / 3.0);
+    for (j, &x) in ee.iter().enumerate().take(k).skip(1) {
+        t_int.add(x, 4.0 * (j as Real * theta).sin() / den / 3.0);
     }
     for (j, &x) in ff.iter().enumerate() {
         let w = ((j as Real * theta).sin() + ((j + 1) as Real * theta).sin()) / den / 3.0;

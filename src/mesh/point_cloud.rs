@@ -24,14 +24,14 @@ impl PointCloud {
     /// match the points one to one.
     pub fn new(positions: Vec<Point3>, normals: Option<Vec<Vector3>>) -> Result<Self> {
         super::poly_mesh::check_finite(&positions)?;
-        if let Some(n) = &normals {
-            if n.len() != positions.len() {
-                return Err(Error::Input(format!(
-                    "{} normals for {} points",
-                    n.len(),
-                    positions.len()
-                )));
-            }
+        if let Some(n) = &normals
+            && n.len() != positions.len()
+        {
+            return Err(Error::Input(format!(
+                "{} normals for {} points",
+                n.len(),
+                positions.len()
+            )));
         }
         Ok(PointCloud { positions, normals })
     }

@@ -77,7 +77,9 @@ impl PolyMesh {
         if self.face_offsets.first().copied().unwrap_or(0) != 0
             || self.face_offsets.last().copied().unwrap_or(0) as usize != self.face_vertices.len()
         {
-            return Err(Error::Input("face offsets do not match face vertices".into()));
+            return Err(Error::Input(
+                "face offsets do not match face vertices".into(),
+            ));
         }
         let n = self.positions.len();
         for (f, face) in self.faces().enumerate() {
@@ -99,7 +101,10 @@ impl PolyMesh {
 
 /// Checks that every coordinate is finite; the error names the first bad vertex.
 pub(crate) fn check_finite(points: &[Point3]) -> Result<()> {
-    match points.iter().position(|p| !p.coords.iter().all(|c| c.is_finite())) {
+    match points
+        .iter()
+        .position(|p| !p.coords.iter().all(|c| c.is_finite()))
+    {
         Some(i) => Err(Error::Input(format!(
             "vertex {i} has a non-finite coordinate ({}, {}, {})",
             points[i].x, points[i].y, points[i].z

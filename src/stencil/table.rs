@@ -104,21 +104,23 @@ impl StencilTable {
     pub fn apply_into(&self, points: &[Point3], out: &mut [Point3]) {
         assert_eq!(points.len(), self.num_cols);
         assert_eq!(out.len(), self.num_rows());
-        out.par_chunks_mut(CHUNK).enumerate().for_each(|(ci, chunk)| {
-            let r0 = ci * CHUNK;
-            for (i, o) in chunk.iter_mut().enumerate() {
-                let (a, b) = (self.offsets[r0 + i], self.offsets[r0 + i + 1]);
-                let (mut x, mut y, mut z) = (0.0, 0.0, 0.0);
-                for k in a..b {
-                    let p = &points[self.indices[k] as usize];
-                    let w = self.weights[k];
-                    x += w * p.x;
-                    y += w * p.y;
-                    z += w * p.z;
+        out.par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(ci, chunk)| {
+                let r0 = ci * CHUNK;
+                for (i, o) in chunk.iter_mut().enumerate() {
+                    let (a, b) = (self.offsets[r0 + i], self.offsets[r0 + i + 1]);
+                    let (mut x, mut y, mut z) = (0.0, 0.0, 0.0);
+                    for k in a..b {
+                        let p = &points[self.indices[k] as usize];
+                        let w = self.weights[k];
+                        x += w * p.x;
+                        y += w * p.y;
+                        z += w * p.z;
+                    }
+                    *o = Point3::new(x, y, z);
                 }
-                *o = Point3::new(x, y, z);
-            }
-        });
+            });
     }
 
     /// Applies the table to scalar values (one per column).
@@ -255,7 +257,9 @@ impl StencilTable {
 
     /// Sum of the weights of each row (1 for an affine-invariant stencil).
     pub fn row_sums(&self) -> Vec<Real> {
-        (0..self.num_rows()).map(|r| self.row(r).1.iter().sum()).collect()
+        (0..self.num_rows())
+            .map(|r| self.row(r).1.iter().sum())
+            .collect()
     }
 
     fn check_input(&self, n: usize) -> Result<()> {

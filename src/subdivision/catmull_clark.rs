@@ -21,7 +21,11 @@ use crate::topology::{Level, NONE, Sharpness, VertexRule, decrement};
 
 /// The stencil table `S` with `P_child = S P_parent` (rows ordered face
 /// points, edge points, vertex points) and the child level's sharpness.
-pub fn refine_stencil(parent: &Level, sharp: &Sharpness, child: &Level) -> (StencilTable, Sharpness) {
+pub fn refine_stencil(
+    parent: &Level,
+    sharp: &Sharpness,
+    child: &Level,
+) -> (StencilTable, Sharpness) {
     let nf = parent.num_faces();
     let ne = parent.num_edges();
     let nv = parent.num_vertices;

@@ -56,15 +56,12 @@ pub fn refine_topology(parent: &Level) -> Level {
     let mut edge_verts = vec![[0u32; 2]; 2 * ne + nc];
     let mut edge_faces = vec![[NONE; 2]; 2 * ne + nc];
     let (halves_v, inner_v) = edge_verts.split_at_mut(2 * ne);
-    halves_v
-        .par_chunks_mut(2)
-        .enumerate()
-        .for_each(|(e, hv)| {
-            let [a, b] = parent.edge_verts[e];
-            let m = ept + e as u32;
-            hv[0] = [vpt + a, m];
-            hv[1] = [m, vpt + b];
-        });
+    halves_v.par_chunks_mut(2).enumerate().for_each(|(e, hv)| {
+        let [a, b] = parent.edge_verts[e];
+        let m = ept + e as u32;
+        hv[0] = [vpt + a, m];
+        hv[1] = [m, vpt + b];
+    });
     inner_v.par_iter_mut().enumerate().for_each(|(c, ev)| {
         *ev = [ept + parent.face_edges[c], fpt + face_of[c]];
     });
@@ -72,25 +69,22 @@ pub fn refine_topology(parent: &Level) -> Level {
     // in face k of the edge the half at `edge_verts[0]` belongs to the child
     // quad at that vertex's corner.
     let (halves_f, inner_f) = edge_faces.split_at_mut(2 * ne);
-    halves_f
-        .par_chunks_mut(2)
-        .enumerate()
-        .for_each(|(e, hf)| {
-            let [a, b] = parent.edge_verts[e];
-            for (k, &f) in parent.edge_faces[e].iter().enumerate() {
-                if f == NONE {
-                    continue;
-                }
-                let f = f as usize;
-                let off = parent.face_offsets[f] as usize;
-                let ca = off + parent.corner_in_face(f, a).unwrap_or(0);
-                let cb = off + parent.corner_in_face(f, b).unwrap_or(0);
-                // In face 0 the edge runs a -> b, in face 1 b -> a; either way
-                // the half at a lies in the child quad of a's corner.
-                hf[0][k] = ca as u32;
-                hf[1][k] = cb as u32;
+    halves_f.par_chunks_mut(2).enumerate().for_each(|(e, hf)| {
+        let [a, b] = parent.edge_verts[e];
+        for (k, &f) in parent.edge_faces[e].iter().enumerate() {
+            if f == NONE {
+                continue;
             }
-        });
+            let f = f as usize;
+            let off = parent.face_offsets[f] as usize;
+            let ca = off + parent.corner_in_face(f, a).unwrap_or(0);
+            let cb = off + parent.corner_in_face(f, b).unwrap_or(0);
+            // In face 0 the edge runs a -> b, in face 1 b -> a; either way
+            // the half at a lies in the child quad of a's corner.
+            hf[0][k] = ca as u32;
+            hf[1][k] = cb as u32;
+        }
+    });
     inner_f.par_iter_mut().enumerate().for_each(|(c, ef)| {
         let f = face_of[c] as usize;
         let a = parent.face_offsets[f] as usize;

@@ -161,7 +161,10 @@ impl Hierarchy {
     }
 
     /// Positions of every level, refining level by level from `p0`.
-    pub fn refine_positions(&self, p0: &[crate::math::Point3]) -> Result<Vec<Vec<crate::math::Point3>>> {
+    pub fn refine_positions(
+        &self,
+        p0: &[crate::math::Point3],
+    ) -> Result<Vec<Vec<crate::math::Point3>>> {
         let mut out = vec![p0.to_vec()];
         for s in &self.stencils {
             let next = s.apply(out.last().expect("level 0"))?;

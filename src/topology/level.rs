@@ -86,7 +86,10 @@ impl Level {
         let nh = mesh.face_vertices.len();
         let mut half: Vec<(u64, u32)> = Vec::with_capacity(nh);
         for f in 0..mesh.num_faces() {
-            let (a, b) = (mesh.face_offsets[f] as usize, mesh.face_offsets[f + 1] as usize);
+            let (a, b) = (
+                mesh.face_offsets[f] as usize,
+                mesh.face_offsets[f + 1] as usize,
+            );
             for k in a..b {
                 let v0 = mesh.face_vertices[k];
                 let v1 = mesh.face_vertices[if k + 1 == b { a } else { k + 1 }];
@@ -95,7 +98,7 @@ impl Level {
             }
         }
         half.sort_unstable();
-        let face_of = face_of_corner(&mesh.face_offsets);
+        let face_of = face_of_corner(mesh.face_offsets);
         let mut face_edges = vec![0u32; nh];
         let mut edge_verts = Vec::with_capacity(nh / 2 + 1);
         let mut edge_faces = Vec::with_capacity(nh / 2 + 1);
@@ -234,7 +237,9 @@ impl Level {
 
     /// True when vertex `v` lies on a boundary edge.
     pub fn is_boundary_vertex(&self, v: usize) -> bool {
-        self.vertex_edges(v).iter().any(|&e| self.is_boundary_edge(e as usize))
+        self.vertex_edges(v)
+            .iter()
+            .any(|&e| self.is_boundary_edge(e as usize))
     }
 
     /// The vertex at the other end of edge `e` from `v`.

@@ -65,10 +65,14 @@ impl Sharpness {
     /// Level-0 sharpness: user creases `(i, j, s)` (vertex pairs, 0-based),
     /// boundary edges infinite, and — for the edge-and-corner boundary rule —
     /// boundary vertices with a single face infinitely sharp (corners).
-    pub fn initial(level: &Level, creases: &[(u32, u32, Real)], corners: bool) -> Result<Sharpness> {
+    pub fn initial(
+        level: &Level,
+        creases: &[(u32, u32, Real)],
+        corners: bool,
+    ) -> Result<Sharpness> {
         let mut edge = vec![0.0; level.num_edges()];
         for (k, &(i, j, s)) in creases.iter().enumerate() {
-            if !(s >= 0.0) {
+            if s.is_nan() || s < 0.0 {
                 return Err(Error::Input(format!(
                     "crease {k} ({i}, {j}) has sharpness {s}; sharpness must be ≥ 0"
                 )));

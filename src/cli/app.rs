@@ -1,0 +1,67 @@
+//! The `subdyn` command line: verbs, error printing and exit codes.
+//!
+//! Exit codes: 0 success, 1 bad input or a failed run (one line on stderr,
+//! `subdyn: error: …`), 2 bad usage (clap's own message).
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use super::{bench, common, info, limit, subdivide};
+
+/// subdyn: Catmull-Clark subdivision surfaces — refinement as stencil tables,
+/// exact limit evaluation, mesh inspection and benchmarks.
+#[derive(Debug, Parser)]
+#[command(name = "subdyn", version, propagate_version = true)]
+#[command(
+    after_help = "Output formats follow the extension: .obj, .ply, .off, .xyz (optionally .gz)."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// The verbs.
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Refine a mesh uniformly with Catmull-Clark (the embedded cube when no INPUT is given).
+    Subdivide(subdivide::SubdivideArgs),
+    /// Tessellate the limit surface: every quad face as a K×K grid of exact limit samples.
+    Limit(limit::LimitArgs),
+    /// Print counts, boundaries, components, genus, valences and the bounding box of a mesh or point file.
+    Info(info::InfoArgs),
+    /// Benchmarks (timings as a table, then one JSON line).
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
+}
+
+/// Parses the command line, runs the verb and turns any error into one line
+/// on stderr and exit code 1.
+pub fn run() -> ExitCode {
+    common::install_panic_hook();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Subdivide(args) => subdivide::run(&args),
+        Command::Limit(args) => limit::run(&args),
+        Command::Info(args) => info::run(&args),
+        Command::Bench(cmd) => bench::run(&cmd),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            common::print_error(&err);
+            ExitCode::from(1)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_command_line_definition_is_consistent() {
+        use clap::CommandFactory;
+        Cli::command().debug_assert();
+    }
+}

@@ -1,0 +1,290 @@
+//! `subdyn bench subdivide`: time every stage of uniform refinement of an
+//! N×N quad torus and compare with OpenSubdiv 3.6.
+//!
+//! Stages, timed separately: level-0 topology ([`Refiner::new`]), topology
+//! refinement ([`refine_topology`] per level), stencil build ([`refine_stencil`]
+//! per level, composed into one table `P_L = S P_0`), stencil application
+//! (the composed table, best of `--repeat`), and level-by-level application.
+
+use std::fmt::Write as _;
+
+use clap::{Args, Subcommand};
+use serde_json::json;
+
+use subdyn::math::Point3;
+use subdyn::stencil::StencilTable;
+use subdyn::subdivision::{RefineOptions, Refiner, refine_stencil, refine_topology};
+use subdyn::topology::Level;
+
+use super::common::{print_stdout, thousands, timed};
+use super::progress::Progress;
+use super::subdivide::MAX_FACES;
+
+/// OpenSubdiv 3.6 on this project's 2-core machine, 316×316 torus, level 2,
+/// CPU, single thread, float: (stage, seconds).
+const OPENSUBDIV: [(&str, f64); 4] = [
+    ("topology_s", 0.05),
+    ("refine_s", 0.24),
+    ("stencil_build_s", 1.4),
+    ("stencil_apply_s", 0.034),
+];
+
+/// Benchmarks.
+#[derive(Debug, Subcommand)]
+pub enum BenchCommand {
+    /// Uniform Catmull-Clark refinement of an N×N quad torus, stage by stage;
+    /// the last stdout line is one JSON object with the seconds.
+    Subdivide(BenchSubdivideArgs),
+}
+
+/// Arguments of `subdyn bench subdivide`.
+#[derive(Debug, Args)]
+pub struct BenchSubdivideArgs {
+    /// The torus has N×N quads.
+    #[arg(long, value_name = "N", default_value_t = 316)]
+    pub grid: usize,
+    /// Refinement levels (1 to 8).
+    #[arg(long, value_name = "L", default_value_t = 2)]
+    pub levels: usize,
+    /// Stencil applications timed; the best is reported.
+    #[arg(long, value_name = "R", default_value_t = 5)]
+    pub repeat: usize,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "T")]
+    pub threads: Option<usize>,
+    /// No progress display.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Runs a benchmark.
+pub fn run(cmd: &BenchCommand) -> anyhow::Result<()> {
+    match cmd {
+        BenchCommand::Subdivide(args) => bench_subdivide(args),
+    }
+}
+
+/// Seconds of each stage and the sizes involved.
+struct Timings {
+    topology_s: f64,
+    refine_s: f64,
+    stencil_build_s: f64,
+    stencil_apply_s: f64,
+    apply_levelwise_s: f64,
+    vertices: usize,
+    faces: usize,
+    stencil_entries: usize,
+    max_abs_diff: f64,
+}
+
+fn bench_subdivide(args: &BenchSubdivideArgs) -> anyhow::Result<()> {
+    if args.grid < 3 {
+        anyhow::bail!(
+            "--grid {} is too small: a quad torus needs N ≥ 3",
+            args.grid
+        );
+    }
+    if args.levels == 0 || args.levels > 8 {
+        anyhow::bail!("--levels {} is out of range: expected 1 to 8", args.levels);
+    }
+    let faces = (args.grid * args.grid) as f64 * 4f64.powi(args.levels as i32);
+    if faces > MAX_FACES as f64 {
+        anyhow::bail!(
+            "--grid {} --levels {} would make about {} faces (at most {} allowed)",
+            args.grid,
+            args.levels,
+            thousands(faces as usize),
+            thousands(MAX_FACES)
+        );
+    }
+    if args.repeat == 0 {
+        anyhow::bail!("--repeat must be at least 1");
+    }
+    if let Some(t) = args.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build_global()
+            .map_err(|e| anyhow::anyhow!("cannot start {t} threads: {e}"))?;
+    }
+    let progress = Progress::new(args.quiet);
+    let t = measure(args, &progress)?;
+    drop(progress);
+
+    let threads = rayon::current_num_threads();
+    let ours = [
+        t.topology_s,
+        t.refine_s,
+        t.stencil_build_s,
+        t.stencil_apply_s,
+    ];
+    let setup = t.topology_s + t.refine_s + t.stencil_build_s;
+    let osd_setup: f64 = OPENSUBDIV[..3].iter().map(|(_, s)| s).sum();
+
+    let mut text = String::new();
+    let n = args.grid;
+    let _ = writeln!(
+        text,
+        "subdyn bench subdivide: {n}×{n} quad torus ({} faces), {} level{} -> {} vertices, {} faces",
+        thousands(n * n),
+        args.levels,
+        if args.levels == 1 { "" } else { "s" },
+        thousands(t.vertices),
+        thousands(t.faces)
+    );
+    let _ = writeln!(
+        text,
+        "composed stencil table: {} rows, {} entries; f64; {threads} threads; apply = best of {}",
+        thousands(t.vertices),
+        thousands(t.stencil_entries),
+        args.repeat
+    );
+    let _ = writeln!(text);
+    let _ = writeln!(
+        text,
+        "{:<28}{:>12}{:>16}{:>9}",
+        "stage", "subdyn (s)", "OpenSubdiv (s)", "ratio"
+    );
+    let names = ["topology", "refinement", "stencil build", "stencil apply"];
+    for ((name, ours), (_, osd)) in names.iter().zip(ours).zip(OPENSUBDIV) {
+        let _ = writeln!(text, "{name:<28}{ours:>12.4}{osd:>16.3}{:>9.2}", ours / osd);
+    }
+    let _ = writeln!(
+        text,
+        "{:<28}{setup:>12.4}{osd_setup:>16.3}{:>9.2}",
+        "setup (sum of first three)",
+        setup / osd_setup
+    );
+    let _ = writeln!(
+        text,
+        "{:<28}{:>12.4}{:>16}",
+        "apply level by level", t.apply_levelwise_s, "-"
+    );
+    let _ = writeln!(
+        text,
+        "OpenSubdiv 3.6: 316×316 torus, level 2, CPU, 1 thread, float (ratio = subdyn / OpenSubdiv; \
+         comparable only at --grid 316 --levels 2)"
+    );
+    let _ = writeln!(
+        text,
+        "composed vs level-by-level positions: max |difference| = {:.3e}",
+        t.max_abs_diff
+    );
+    let reference: serde_json::Map<String, serde_json::Value> = OPENSUBDIV
+        .iter()
+        .map(|(k, s)| (k.to_string(), json!(s)))
+        .collect();
+    let ratios: serde_json::Map<String, serde_json::Value> = OPENSUBDIV
+        .iter()
+        .zip(ours)
+        .map(|((k, s), o)| (k.to_string(), json!(o / s)))
+        .chain([("setup_s".to_string(), json!(setup / osd_setup))])
+        .collect();
+    let line = json!({
+        "topology_s": t.topology_s,
+        "refine_s": t.refine_s,
+        "stencil_build_s": t.stencil_build_s,
+        "stencil_apply_s": t.stencil_apply_s,
+        "apply_levelwise_s": t.apply_levelwise_s,
+        "setup_s": setup,
+        "grid": n,
+        "levels": args.levels,
+        "vertices": t.vertices,
+        "faces": t.faces,
+        "stencil_entries": t.stencil_entries,
+        "repeat": args.repeat,
+        "threads": threads,
+        "precision": "f64",
+        "max_abs_diff": t.max_abs_diff,
+        "opensubdiv_reference": reference,
+        "ratios": ratios,
+    });
+    let _ = writeln!(text, "{line}");
+    print_stdout(&text)
+}
+
+fn measure(args: &BenchSubdivideArgs, progress: &Progress) -> anyhow::Result<Timings> {
+    let mesh = subdyn::examples::torus(args.grid, args.grid, 1.0, 0.3);
+    let p0 = &mesh.positions;
+
+    progress.stage("level-0 topology");
+    let (refiner, topology_s) = timed(|| Refiner::new(&mesh, &RefineOptions::default()));
+    let refiner = refiner?;
+
+    progress.stage("refining the topology");
+    let (children, refine_s) = timed(|| {
+        let mut children: Vec<Level> = Vec::with_capacity(args.levels);
+        for _ in 0..args.levels {
+            let child = refine_topology(children.last().unwrap_or(&refiner.level));
+            children.push(child);
+        }
+        children
+    });
+
+    progress.stage("building the stencil tables");
+    let sharp0 = refiner.sharpness.clone();
+    let (built, stencil_build_s) = timed(|| -> anyhow::Result<_> {
+        let mut tables: Vec<StencilTable> = Vec::with_capacity(args.levels);
+        let mut sharp = sharp0;
+        for (k, child) in children.iter().enumerate() {
+            let parent = if k == 0 {
+                &refiner.level
+            } else {
+                &children[k - 1]
+            };
+            let (table, next) = refine_stencil(parent, &sharp, child);
+            tables.push(table);
+            sharp = next;
+        }
+        let mut composed: Option<StencilTable> = None;
+        for table in &tables[1..] {
+            let inner = composed.as_ref().unwrap_or(&tables[0]);
+            composed = Some(table.compose(inner)?);
+        }
+        Ok((tables, composed))
+    });
+    let (tables, composed) = built?;
+    let composed = composed.as_ref().unwrap_or(&tables[0]);
+
+    progress.stage("applying the composed stencil table");
+    let mut out = vec![Point3::origin(); composed.num_rows()];
+    let stencil_apply_s = best_of(args.repeat, || composed.apply_into(p0, &mut out));
+
+    progress.stage("applying the stencil tables level by level");
+    let mut buffers: Vec<Vec<Point3>> = tables
+        .iter()
+        .map(|t| vec![Point3::origin(); t.num_rows()])
+        .collect();
+    let apply_levelwise_s = best_of(args.repeat, || {
+        for (k, table) in tables.iter().enumerate() {
+            let (done, rest) = buffers.split_at_mut(k);
+            let input = done.last().map_or(p0.as_slice(), Vec::as_slice);
+            table.apply_into(input, &mut rest[0]);
+        }
+    });
+    let finest = buffers.last().map_or(p0.as_slice(), Vec::as_slice);
+    let max_abs_diff = out
+        .iter()
+        .zip(finest)
+        .map(|(a, b)| (a - b).amax())
+        .fold(0.0, f64::max);
+
+    let finest_level = children.last().unwrap_or(&refiner.level);
+    Ok(Timings {
+        topology_s,
+        refine_s,
+        stencil_build_s,
+        stencil_apply_s,
+        apply_levelwise_s,
+        vertices: finest_level.num_vertices,
+        faces: finest_level.num_faces(),
+        stencil_entries: composed.num_entries(),
+        max_abs_diff,
+    })
+}
+
+/// The shortest of `repeat` runs of `f`, in seconds.
+fn best_of(repeat: usize, mut f: impl FnMut()) -> f64 {
+    (0..repeat)
+        .map(|_| timed(&mut f).1)
+        .fold(f64::INFINITY, f64::min)
+}

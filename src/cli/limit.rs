@@ -1,0 +1,124 @@
+//! `subdyn limit IN -o OUT --tess K`: tessellate the limit surface.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use serde_json::json;
+
+use subdyn::io::write_mesh;
+use subdyn::limit::tessellate;
+
+use super::common::{
+    about_file, bbox_json, check_mesh_output, print_stdout, seconds, thousands, timed, write_report,
+};
+use super::options::{RefineArgs, read_polygon_mesh};
+use super::progress::Progress;
+use super::subdivide::MAX_FACES;
+
+/// Largest `--tess` accepted.
+pub const MAX_TESS: usize = 256;
+
+/// Arguments of `subdyn limit`.
+#[derive(Debug, Args)]
+pub struct LimitArgs {
+    /// Input control mesh (.obj, .ply, .off).
+    #[arg(value_name = "IN")]
+    pub input: PathBuf,
+    /// Output mesh; the format follows the extension.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Samples per quad edge: each quad (each quad sub-face of an n-gon)
+    /// becomes a K×K grid of quads whose vertices lie on the limit surface.
+    #[arg(short = 'k', long = "tess", value_name = "K", default_value_t = 4)]
+    pub tess: usize,
+    /// Also write the limit-surface unit normal of every output vertex.
+    #[arg(long)]
+    pub normals: bool,
+    #[command(flatten)]
+    pub refine: RefineArgs,
+    /// Write a JSON report (counts, timings, bounding box).
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<PathBuf>,
+    /// No progress display and no warnings.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Runs `subdyn limit`.
+pub fn run(args: &LimitArgs) -> anyhow::Result<()> {
+    let start = Instant::now();
+    check_mesh_output(&args.output)?;
+    if args.tess == 0 || args.tess > MAX_TESS {
+        anyhow::bail!(
+            "--tess {} is out of range: expected 1 to {MAX_TESS}",
+            args.tess
+        );
+    }
+    let progress = Progress::new(args.quiet);
+    let name = args.input.display().to_string();
+    progress.stage("reading the mesh");
+    let (mesh, read_s) = timed(|| read_polygon_mesh(&args.input, args.quiet));
+    let mesh = mesh?;
+    // Quads (and quad sub-faces of n-gons) times K² faces each.
+    let quads = mesh
+        .faces()
+        .map(|f| if f.len() == 4 { 1 } else { f.len() })
+        .sum::<usize>();
+    let faces = quads as f64 * (args.tess * args.tess) as f64;
+    if faces > MAX_FACES as f64 {
+        anyhow::bail!(
+            "{name}: --tess {} would make about {} faces (at most {} allowed); use a smaller K",
+            args.tess,
+            thousands(faces as usize),
+            thousands(MAX_FACES)
+        );
+    }
+
+    progress.stage("building the topology");
+    let (refiner, topology_s) = timed(|| args.refine.refiner(&mesh, &name));
+    let refiner = refiner?;
+    progress.stage(format!(
+        "tessellating the limit surface ({0}×{0} per quad)",
+        args.tess
+    ));
+    let (tess, tess_s) = timed(|| tessellate(&refiner, &mesh.positions, args.tess));
+    let (out, normals) = tess.map_err(|e| about_file(e, &args.input))?;
+
+    progress.stage(format!("writing {}", args.output.display()));
+    let normals = args.normals.then_some(normals.as_slice());
+    let (written, write_s) = timed(|| write_mesh(&args.output, &out, normals));
+    written.map_err(|e| about_file(e, &args.output))?;
+    drop(progress);
+
+    if let Some(report) = &args.report {
+        let value = json!({
+            "command": "limit",
+            "input": name,
+            "output": args.output.display().to_string(),
+            "tess": args.tess,
+            "normals": args.normals,
+            "boundary": args.refine.boundary.name(),
+            "creases": refiner.options.creases.len(),
+            "control": {"vertices": mesh.num_vertices(), "faces": mesh.num_faces()},
+            "tessellation": {"vertices": out.num_vertices(), "faces": out.num_faces()},
+            "timings_s": {
+                "read": read_s,
+                "topology": topology_s,
+                "tessellate": tess_s,
+                "write": write_s,
+                "total": seconds(start),
+            },
+            "bbox": bbox_json(&out.positions),
+        });
+        write_report(report, &value)?;
+    }
+    print_stdout(&format!(
+        "tessellated the limit surface of {name} ({0}×{0} per quad): {1} vertices, {2} faces{3}, written to {4}\n",
+        args.tess,
+        thousands(out.num_vertices()),
+        thousands(out.num_faces()),
+        if args.normals { " with normals" } else { "" },
+        args.output.display()
+    ))
+}

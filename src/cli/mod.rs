@@ -1,0 +1,13 @@
+//! The command-line interface: one file per verb, shared helpers in `common`.
+
+mod app;
+mod bench;
+mod common;
+mod info;
+mod limit;
+mod mesh_stats;
+mod options;
+mod progress;
+mod subdivide;
+
+pub use app::run;

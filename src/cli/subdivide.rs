@@ -1,0 +1,186 @@
+//! `subdyn subdivide [IN] -o OUT --levels N`: uniform Catmull-Clark refinement.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use serde_json::json;
+
+use subdyn::io::write_mesh;
+use subdyn::math::Point3;
+use subdyn::mesh::PolyMesh;
+use subdyn::subdivision::Hierarchy;
+
+use super::common::{
+    about_file, bbox_json, check_mesh_output, print_stdout, seconds, thousands, timed, write_report,
+};
+use super::options::{RefineArgs, read_polygon_mesh};
+use super::progress::Progress;
+
+/// Most levels `subdivide` accepts (faces grow by 4× per level).
+pub const MAX_LEVELS: usize = 8;
+/// Most faces `subdivide` will produce.
+pub const MAX_FACES: usize = 50_000_000;
+
+/// Arguments of `subdyn subdivide`.
+#[derive(Debug, Args)]
+pub struct SubdivideArgs {
+    /// Input mesh (.obj, .ply, .off); without it, the embedded unit cube is refined.
+    #[arg(value_name = "IN")]
+    pub input: Option<PathBuf>,
+    /// Output mesh; the format follows the extension.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Number of uniform refinement levels (0 to 8).
+    #[arg(short, long, default_value_t = 2)]
+    pub levels: usize,
+    /// Move every output vertex to its position on the limit surface.
+    #[arg(long)]
+    pub limit: bool,
+    #[command(flatten)]
+    pub refine: RefineArgs,
+    /// Write a JSON report (counts per level, timings, bounding box).
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<PathBuf>,
+    /// No progress display and no warnings.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Runs `subdyn subdivide`.
+pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
+    let start = Instant::now();
+    check_mesh_output(&args.output)?;
+    if args.levels > MAX_LEVELS {
+        anyhow::bail!(
+            "--levels {} is too many: each level multiplies the faces by 4; at most {MAX_LEVELS} levels are allowed",
+            args.levels
+        );
+    }
+    let progress = Progress::new(args.quiet);
+    progress.stage("reading the mesh");
+    let ((mesh, input_name), read_s) = timed(|| load(args.input.as_deref(), args.quiet));
+    let input_label = match &args.input {
+        Some(path) => path.display().to_string(),
+        None => "embedded:cube".to_string(),
+    };
+    let mesh = mesh?;
+    check_size(&mesh, args.levels, &input_name)?;
+
+    progress.stage("building the topology");
+    let (refiner, topology_s) = timed(|| args.refine.refiner(&mesh, &input_name));
+    let refiner = refiner?;
+    progress.stage(format!("refining to level {}", args.levels));
+    let (hierarchy, refine_s) = timed(|| refiner.refine_uniform(args.levels));
+    let hierarchy = hierarchy?;
+
+    progress.stage("computing the positions");
+    let (positions, positions_s) =
+        timed(|| positions(&hierarchy, &mesh.positions, args.levels, args.limit));
+    let positions = positions?;
+    let bbox = bbox_json(&positions);
+    let out = hierarchy.mesh(args.levels, positions);
+
+    progress.stage(format!("writing {}", args.output.display()));
+    let (written, write_s) = timed(|| write_mesh(&args.output, &out, None));
+    written.map_err(|e| about_file(e, &args.output))?;
+    drop(progress);
+
+    let summary = format!(
+        "{}{} to level {}{}: {} vertices, {} faces, written to {}\n",
+        if args.input.is_none() {
+            "no INPUT given: subdivided "
+        } else {
+            "subdivided "
+        },
+        input_name,
+        args.levels,
+        if args.limit {
+            " (vertices at their limit positions)"
+        } else {
+            ""
+        },
+        thousands(out.num_vertices()),
+        thousands(out.num_faces()),
+        args.output.display()
+    );
+    if let Some(report) = &args.report {
+        let counts: Vec<_> = hierarchy
+            .levels
+            .iter()
+            .enumerate()
+            .map(|(k, l)| json!({"level": k, "vertices": l.num_vertices, "faces": l.num_faces(), "edges": l.num_edges()}))
+            .collect();
+        let value = json!({
+            "command": "subdivide",
+            "input": input_label,
+            "output": args.output.display().to_string(),
+            "levels": args.levels,
+            "boundary": args.refine.boundary.name(),
+            "creases": refiner.options.creases.len(),
+            "limit": args.limit,
+            "counts": counts,
+            "timings_s": {
+                "read": read_s,
+                "topology": topology_s,
+                "refine": refine_s,
+                "positions": positions_s,
+                "write": write_s,
+                "total": seconds(start),
+            },
+            "input_bbox": bbox_json(&mesh.positions),
+            "bbox": bbox,
+        });
+        write_report(report, &value)?;
+    }
+    print_stdout(&summary)
+}
+
+/// The input mesh and its name for messages: the file, or the embedded cube.
+fn load(input: Option<&Path>, quiet: bool) -> (anyhow::Result<PolyMesh>, String) {
+    match input {
+        Some(path) => (read_polygon_mesh(path, quiet), path.display().to_string()),
+        None => (
+            Ok(subdyn::examples::cube()),
+            "the embedded unit cube (8 vertices, 6 quads)".to_string(),
+        ),
+    }
+}
+
+/// Refuses, before allocating anything, a refinement that would exceed [`MAX_FACES`].
+fn check_size(mesh: &PolyMesh, levels: usize, name: &str) -> anyhow::Result<()> {
+    let faces = estimated_faces(mesh, levels);
+    if faces > MAX_FACES as f64 {
+        anyhow::bail!(
+            "{name}: {levels} levels would make about {} faces (at most {} allowed); use fewer levels",
+            thousands(faces as usize),
+            thousands(MAX_FACES)
+        );
+    }
+    Ok(())
+}
+
+/// Faces after `levels` uniform Catmull-Clark levels: an `n`-gon becomes `n`
+/// quads, then every quad becomes 4.
+pub fn estimated_faces(mesh: &PolyMesh, levels: usize) -> f64 {
+    if levels == 0 {
+        return mesh.num_faces() as f64;
+    }
+    mesh.face_vertices.len() as f64 * 4f64.powi(levels as i32 - 1)
+}
+
+/// Positions of level `levels`: refined level by level, or at the limit.
+fn positions(
+    h: &Hierarchy,
+    p0: &[Point3],
+    levels: usize,
+    limit: bool,
+) -> anyhow::Result<Vec<Point3>> {
+    if limit {
+        let table = subdyn::limit::limit_stencil(h, levels)?;
+        return Ok(table.apply(p0)?);
+    }
+    let mut all = h.refine_positions(p0)?;
+    all.pop()
+        .ok_or_else(|| anyhow::anyhow!("the refinement produced no level"))
+}

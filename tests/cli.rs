@@ -1,0 +1,678 @@
+//! End-to-end tests of the `subdyn` binary: every verb on tiny inputs in a
+//! temporary directory, and one test per kind of bad input, each checking a
+//! non-zero exit, a single `subdyn: error: …` line naming the problem, no panic
+//! text and no output (or temporary) file left behind.
+//!
+//! Fixtures: the cube and regular torus of `tests/data/opensubdiv/`; every
+//! other input is written by the test itself. The real scan
+//! `../shared/data/scans/bun045.ply` is used when present, skipped with a note
+//! otherwise.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+/// Runs the `subdyn` binary with `args` in `dir`.
+fn subdyn(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_subdyn"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the subdyn binary runs")
+}
+
+fn stdout(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Asserts success and returns stdout.
+fn ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "expected success, got {:?}\nstdout: {}\nstderr: {}",
+        out.status.code(),
+        stdout(out),
+        stderr(out)
+    );
+    stdout(out)
+}
+
+/// A fixture under `tests/data/`.
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+/// Writes `bytes` to `dir/name`.
+fn write(dir: &Path, name: &str, bytes: &[u8]) {
+    std::fs::write(dir.join(name), bytes).unwrap();
+}
+
+/// Copies the fixture `tests/data/<from>` to `dir/<to>`.
+fn copy(dir: &Path, from: &str, to: &str) {
+    std::fs::copy(data(from), dir.join(to)).unwrap();
+}
+
+/// Parses the `v x y z` lines of an OBJ file.
+fn obj_vertices(path: &Path) -> Vec<[f64; 3]> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let c: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+            [c[0], c[1], c[2]]
+        })
+        .collect()
+}
+
+/// An `n × m` quad torus as OBJ text.
+fn torus_obj(n: usize, m: usize) -> String {
+    use std::f64::consts::TAU;
+    let mut s = String::new();
+    for i in 0..n {
+        let a = TAU * i as f64 / n as f64;
+        for j in 0..m {
+            let b = TAU * j as f64 / m as f64;
+            let r = 1.0 + 0.3 * b.cos();
+            s += &format!("v {} {} {}\n", r * a.cos(), r * a.sin(), 0.3 * b.sin());
+        }
+    }
+    let id = |i: usize, j: usize| (i % n) * m + (j % m) + 1;
+    for i in 0..n {
+        for j in 0..m {
+            s += &format!(
+                "f {} {} {} {}\n",
+                id(i, j),
+                id(i + 1, j),
+                id(i + 1, j + 1),
+                id(i, j + 1)
+            );
+        }
+    }
+    s
+}
+
+/// Runs `info --json` on `dir/name` and parses the result.
+fn info_json(dir: &Path, name: &str) -> Value {
+    let out = ok(&subdyn(dir, &["info", name, "--json"]));
+    serde_json::from_str(out.trim()).expect("info --json prints one JSON object")
+}
+
+/// The names of the files in `dir`.
+fn files(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Asserts a clean failure: exit code 1, exactly one stderr line
+/// `subdyn: error: …` containing every `needle` (case-insensitive), no panic
+/// text, and no file in `dir` other than `inputs`.
+fn assert_clean_failure(dir: &Path, out: &Output, needles: &[&str], inputs: &[&str]) {
+    let err = stderr(out);
+    assert_eq!(out.status.code(), Some(1), "exit code; stderr: {err}");
+    assert!(!err.contains("panicked"), "panic text in: {err}");
+    assert!(!err.contains("RUST_BACKTRACE"), "backtrace hint in: {err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "expected one stderr line, got: {err}");
+    assert!(lines[0].starts_with("subdyn: error: "), "prefix: {err}");
+    for needle in needles {
+        assert!(
+            err.to_lowercase().contains(&needle.to_lowercase()),
+            "`{needle}` not in: {err}"
+        );
+    }
+    let mut expected: Vec<String> = inputs.iter().map(|s| s.to_string()).collect();
+    expected.sort();
+    assert_eq!(files(dir), expected, "files left behind");
+}
+
+/// `subdivide INPUT -o out.obj --levels 1` on a bad `INPUT` written into a
+/// fresh directory must fail cleanly with all `needles` in the message.
+fn bad_input(name: &str, bytes: &[u8], needles: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), name, bytes);
+    let out = subdyn(
+        dir.path(),
+        &["subdivide", name, "-o", "out.obj", "--levels", "1"],
+    );
+    assert_clean_failure(dir.path(), &out, needles, &[name]);
+}
+
+// ---------------------------------------------------------------- subdivide
+
+#[test]
+fn subdivide_embedded_cube_three_levels() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = ok(&subdyn(
+        dir.path(),
+        &[
+            "subdivide",
+            "-o",
+            "cube_l3.obj",
+            "--levels",
+            "3",
+            "--report",
+            "r.json",
+        ],
+    ));
+    assert!(
+        out.contains("embedded unit cube"),
+        "says it used the embedded mesh: {out}"
+    );
+    assert!(out.contains("cube_l3.obj"), "says where it wrote: {out}");
+    assert_eq!(obj_vertices(&dir.path().join("cube_l3.obj")).len(), 386);
+    let info = info_json(dir.path(), "cube_l3.obj");
+    assert_eq!(info["vertices"], 386);
+    assert_eq!(info["faces"], 384);
+    assert_eq!(info["genus"], 0);
+
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    assert_eq!(report["input"], "embedded:cube");
+    assert_eq!(report["levels"], 3);
+    let vertices: Vec<u64> = report["counts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["vertices"].as_u64().unwrap())
+        .collect();
+    assert_eq!(vertices, [8, 26, 98, 386]);
+    assert!(report["timings_s"]["total"].as_f64().unwrap() >= 0.0);
+    assert!(report["bbox"]["diagonal"].as_f64().unwrap() > 1.0);
+}
+
+#[test]
+fn subdivide_file_two_levels_to_every_format() {
+    let dir = tempfile::tempdir().unwrap();
+    copy(dir.path(), "opensubdiv/cube.obj", "cube.obj");
+    for out in ["l2.obj", "l2.ply", "l2.off", "l2.obj.gz"] {
+        ok(&subdyn(
+            dir.path(),
+            &[
+                "subdivide",
+                "cube.obj",
+                "-o",
+                out,
+                "--levels",
+                "2",
+                "--quiet",
+            ],
+        ));
+        let info = info_json(dir.path(), out);
+        assert_eq!(info["vertices"], 98, "{out}");
+        assert_eq!(info["faces"], 96, "{out}");
+    }
+    ok(&subdyn(
+        dir.path(),
+        &["subdivide", "cube.obj", "-o", "l2.xyz", "--levels", "2"],
+    ));
+    assert_eq!(info_json(dir.path(), "l2.xyz")["points"], 98);
+}
+
+#[test]
+fn subdivide_with_creases_keeps_the_sharp_edge() {
+    let dir = tempfile::tempdir().unwrap();
+    copy(dir.path(), "opensubdiv/cube.obj", "cube.obj");
+    // Cube vertices 0 = (0,0,0) and 1 = (0,0,1) share an edge.
+    write(dir.path(), "cube.creases", b"# i j s\n0 1 inf\n1 3 2.5\n");
+    let has_midpoint = |name: &str| {
+        obj_vertices(&dir.path().join(name))
+            .iter()
+            .any(|p| p[0].abs() < 1e-12 && p[1].abs() < 1e-12 && (p[2] - 0.5).abs() < 1e-12)
+    };
+    ok(&subdyn(
+        dir.path(),
+        &[
+            "subdivide",
+            "cube.obj",
+            "-o",
+            "sharp.obj",
+            "--levels",
+            "1",
+            "--creases",
+            "cube.creases",
+        ],
+    ));
+    ok(&subdyn(
+        dir.path(),
+        &["subdivide", "cube.obj", "-o", "smooth.obj", "--levels", "1"],
+    ));
+    // On an infinitely sharp edge the edge point is the edge's midpoint.
+    assert!(has_midpoint("sharp.obj"));
+    assert!(!has_midpoint("smooth.obj"));
+}
+
+#[test]
+fn subdivide_limit_matches_limit_tessellation_extent() {
+    let dir = tempfile::tempdir().unwrap();
+    copy(dir.path(), "opensubdiv/cube.obj", "cube.obj");
+    let args = [
+        "subdivide",
+        "cube.obj",
+        "-o",
+        "lim.obj",
+        "--levels",
+        "2",
+        "--limit",
+    ];
+    ok(&subdyn(
+        dir.path(),
+        &[&args[..], &["--report", "a.json"]].concat(),
+    ));
+    ok(&subdyn(
+        dir.path(),
+        &[
+            "subdivide",
+            "cube.obj",
+            "-o",
+            "ref.obj",
+            "--levels",
+            "2",
+            "--report",
+            "b.json",
+        ],
+    ));
+    ok(&subdyn(
+        dir.path(),
+        &[
+            "limit", "cube.obj", "-o", "t.obj", "--tess", "4", "--report", "c.json",
+        ],
+    ));
+    let read = |n: &str| -> Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join(n)).unwrap()).unwrap()
+    };
+    let (a, b, c) = (read("a.json"), read("b.json"), read("c.json"));
+    let min = |v: &Value| v["bbox"]["min"][0].as_f64().unwrap();
+    // A convex cage: limit points lie further inside than level-2 vertices.
+    assert!(min(&a) > min(&b) + 1e-3, "{} vs {}", min(&a), min(&b));
+    // Both grids contain the limit points at the face centres, the extremes.
+    assert!(
+        (min(&a) - min(&c)).abs() < 1e-12,
+        "{} vs {}",
+        min(&a),
+        min(&c)
+    );
+    assert_eq!(a["limit"], true);
+}
+
+#[test]
+fn subdivide_refuses_absurd_levels_before_working() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = subdyn(dir.path(), &["subdivide", "-o", "x.obj", "--levels", "9"]);
+    assert_clean_failure(dir.path(), &out, &["--levels 9", "at most 8"], &[]);
+    // 8 levels of a 30×30 torus would make 900 × 4⁸ ≈ 59 million faces.
+    write(dir.path(), "torus.obj", torus_obj(30, 30).as_bytes());
+    let out = subdyn(
+        dir.path(),
+        &["subdivide", "torus.obj", "-o", "x.obj", "--levels", "8"],
+    );
+    assert_clean_failure(
+        dir.path(),
+        &out,
+        &["torus.obj", "faces", "fewer levels"],
+        &["torus.obj"],
+    );
+}
+
+#[test]
+fn subdivide_warns_about_isolated_vertices_unless_quiet() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "q.obj",
+        b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 9 9 9\nf 1 2 3 4\n",
+    );
+    let out = subdyn(
+        dir.path(),
+        &["subdivide", "q.obj", "-o", "o.obj", "--levels", "1"],
+    );
+    ok(&out);
+    assert!(stderr(&out).contains("isolated"), "{}", stderr(&out));
+    // The isolated vertex is carried along: 1 + 4 + 4 + 1.
+    assert_eq!(obj_vertices(&dir.path().join("o.obj")).len(), 10);
+    let out = subdyn(
+        dir.path(),
+        &["subdivide", "q.obj", "-o", "o.obj", "--levels", "1", "-q"],
+    );
+    ok(&out);
+    assert_eq!(stderr(&out), "");
+}
+
+#[test]
+fn usage_errors_exit_with_code_two() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = subdyn(dir.path(), &["subdivide", "--levels", "2"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = subdyn(
+        dir.path(),
+        &["subdivide", "-o", "x.obj", "--boundary", "sideways"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let out = subdyn(dir.path(), &["frobnicate"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(files(dir.path()).is_empty());
+}
+
+#[test]
+fn boundary_rules_differ_on_an_open_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    copy(dir.path(), "opensubdiv/grid4_open.obj", "g.obj");
+    for rule in ["edge-and-corner", "edge-only"] {
+        let out = format!("{rule}.obj");
+        ok(&subdyn(
+            dir.path(),
+            &[
+                "subdivide",
+                "g.obj",
+                "-o",
+                &out,
+                "--boundary",
+                rule,
+                "-l",
+                "2",
+            ],
+        ));
+    }
+    let a = obj_vertices(&dir.path().join("edge-and-corner.obj"));
+    let b = obj_vertices(&dir.path().join("edge-only.obj"));
+    assert_eq!(a.len(), b.len());
+    assert_ne!(a, b, "edge-only moves the corners");
+}
+
+// ---------------------------------------------------------------- bad input
+
+#[test]
+fn bad_truncated_ply() {
+    let ply = b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n";
+    bad_input("t.ply", ply, &["t.ply", "4 vertices"]);
+}
+
+#[test]
+fn bad_binary_ply_with_wrong_face_count() {
+    let mut ply = b"ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\n\
+property float y\nproperty float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+        .to_vec();
+    for p in [[0f32, 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]] {
+        for c in p {
+            ply.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    ply.push(4);
+    for i in 0i32..4 {
+        ply.extend_from_slice(&i.to_le_bytes());
+    }
+    bad_input("b.ply", &ply, &["b.ply", "2 faces"]);
+}
+
+#[test]
+fn bad_obj_index_zero() {
+    bad_input(
+        "z.obj",
+        b"v 0 0 0\nv 1 0 0\nv 1 1 0\nf 0 1 2\n",
+        &["z.obj:4", "index 0"],
+    );
+}
+
+#[test]
+fn bad_obj_index_out_of_range() {
+    bad_input(
+        "r.obj",
+        b"v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 9\n",
+        &["r.obj:4", "9"],
+    );
+}
+
+#[test]
+fn bad_nan_coordinate() {
+    bad_input(
+        "n.obj",
+        b"v 0 0 0\nv nan 0 0\nv 1 1 0\nf 1 2 3\n",
+        &["n.obj:2", "nan"],
+    );
+}
+
+#[test]
+fn bad_non_manifold_edge() {
+    // Three quads share the edge between vertices 1 and 2 (0-based 0 and 1).
+    let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 -1 0\nv 1 -1 0\nv 0 0 1\nv 1 0 1\n\
+f 1 2 4 3\nf 2 1 5 6\nf 1 2 8 7\n";
+    bad_input("m.obj", obj, &["m.obj", "non-manifold edge", "(0, 1)"]);
+}
+
+#[test]
+fn bad_empty_file() {
+    bad_input("e.obj", b"", &["e.obj", "empty"]);
+}
+
+#[test]
+fn bad_missing_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = subdyn(dir.path(), &["subdivide", "nope.obj", "-o", "out.obj"]);
+    assert_clean_failure(dir.path(), &out, &["nope.obj", "no such file"], &[]);
+    let out = subdyn(dir.path(), &["info", "nope.ply"]);
+    assert_clean_failure(dir.path(), &out, &["nope.ply", "no such file"], &[]);
+}
+
+#[test]
+fn bad_unknown_extension() {
+    bad_input("m.stl", b"solid x\nendsolid x\n", &["m.stl", "extension"]);
+    // An unknown output extension is refused before any work.
+    let dir = tempfile::tempdir().unwrap();
+    let out = subdyn(dir.path(), &["subdivide", "-o", "out.stl"]);
+    assert_clean_failure(dir.path(), &out, &["out.stl", "extension"], &[]);
+}
+
+#[test]
+fn bad_point_file_for_subdivide() {
+    bad_input("p.xyz", b"0 0 0\n1 0 0\n0 1 0\n", &["p.xyz", "no faces"]);
+}
+
+#[test]
+fn bad_crease_file() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "c.txt", b"0 1 inf\n0 7 2\n");
+    let out = subdyn(
+        dir.path(),
+        &["subdivide", "-o", "o.obj", "--creases", "c.txt"],
+    );
+    assert_clean_failure(
+        dir.path(),
+        &out,
+        &["c.txt", "0 and 7", "not joined"],
+        &["c.txt"],
+    );
+    write(dir.path(), "c.txt", b"0 1\n");
+    let out = subdyn(
+        dir.path(),
+        &["subdivide", "-o", "o.obj", "--creases", "c.txt"],
+    );
+    assert_clean_failure(dir.path(), &out, &["c.txt:1", "3 columns"], &["c.txt"]);
+}
+
+#[test]
+fn failed_run_keeps_the_previous_output_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "out.obj", b"# previous\n");
+    write(dir.path(), "bad.obj", b"v 0 0 0\nf 1 2 3\n");
+    let out = subdyn(dir.path(), &["subdivide", "bad.obj", "-o", "out.obj"]);
+    assert_clean_failure(dir.path(), &out, &["bad.obj"], &["bad.obj", "out.obj"]);
+    assert_eq!(
+        std::fs::read(dir.path().join("out.obj")).unwrap(),
+        b"# previous\n"
+    );
+}
+
+// ---------------------------------------------------------------- limit
+
+#[test]
+fn limit_of_closed_cube_is_watertight_with_normals() {
+    let dir = tempfile::tempdir().unwrap();
+    copy(dir.path(), "opensubdiv/cube.obj", "cube.obj");
+    let out = ok(&subdyn(
+        dir.path(),
+        &[
+            "limit",
+            "cube.obj",
+            "-o",
+            "t.ply",
+            "--tess",
+            "3",
+            "--normals",
+            "--report",
+            "r.json",
+        ],
+    ));
+    assert!(out.contains("t.ply"), "{out}");
+    let info = info_json(dir.path(), "t.ply");
+    assert_eq!(info["faces"], 6 * 9);
+    assert_eq!(info["boundary_edges"], 0, "watertight");
+    assert_eq!(info["genus"], 0);
+    assert_eq!(info["normals"], true);
+    let out = subdyn(
+        dir.path(),
+        &["limit", "cube.obj", "-o", "x.obj", "--tess", "0"],
+    );
+    assert_clean_failure(
+        dir.path(),
+        &out,
+        &["--tess 0"],
+        &["cube.obj", "r.json", "t.ply"],
+    );
+}
+
+// ---------------------------------------------------------------- info
+
+#[test]
+fn info_reports_genus_of_cube_and_torus() {
+    let dir = tempfile::tempdir().unwrap();
+    copy(dir.path(), "opensubdiv/cube.obj", "cube.obj");
+    copy(dir.path(), "opensubdiv/torus_regular.obj", "torus.obj");
+    let cube = info_json(dir.path(), "cube.obj");
+    assert_eq!(
+        (cube["vertices"].as_u64(), cube["edges"].as_u64()),
+        (Some(8), Some(12))
+    );
+    assert_eq!(cube["euler"], 2);
+    assert_eq!(cube["genus"], 0);
+    assert_eq!(cube["valences"]["3"], 8);
+    let torus = info_json(dir.path(), "torus.obj");
+    assert_eq!(torus["euler"], 0);
+    assert_eq!(torus["genus"], 1);
+    assert_eq!(torus["boundary_loops"], 0);
+    let text = ok(&subdyn(dir.path(), &["info", "torus.obj"]));
+    assert!(text.contains("genus:                1"), "{text}");
+    assert!(text.contains("components:           1"), "{text}");
+}
+
+#[test]
+fn info_on_open_and_non_manifold_meshes() {
+    let dir = tempfile::tempdir().unwrap();
+    copy(dir.path(), "opensubdiv/fan5_open.obj", "fan.obj");
+    let fan = info_json(dir.path(), "fan.obj");
+    assert_eq!(fan["boundary_loops"], 1);
+    assert_eq!(fan["genus"], Value::Null);
+    assert!(ok(&subdyn(dir.path(), &["info", "fan.obj"])).contains("n/a"));
+    write(
+        dir.path(),
+        "m.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 -1 0\nv 1 -1 0\nv 0 0 1\nv 1 0 1\n\
+f 1 2 4 3\nf 2 1 5 6\nf 1 2 8 7\n",
+    );
+    let m = info_json(dir.path(), "m.obj");
+    assert_eq!(m["non_manifold_edges"], 1);
+    assert_eq!(m["subdividable"], false);
+    assert!(m["problem"].as_str().unwrap().contains("non-manifold"));
+}
+
+#[test]
+fn info_on_point_files() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "p.xyz",
+        b"0 0 0 0 0 1\n1 0 0 0 0 1\n0 2 0 0 0 1\n1 2 3 0 0 1\n",
+    );
+    let text = ok(&subdyn(dir.path(), &["info", "p.xyz"]));
+    assert!(text.contains("points:               4"), "{text}");
+    assert!(text.contains("normals:              yes"), "{text}");
+    let p = info_json(dir.path(), "p.xyz");
+    assert_eq!(p["kind"], "points");
+    assert!((p["bbox"]["diagonal"].as_f64().unwrap() - 14f64.sqrt()).abs() < 1e-12);
+    write(
+        dir.path(),
+        "p.ply",
+        b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n\
+property float z\nend_header\n0 0 0\n1 1 1\n",
+    );
+    let p = info_json(dir.path(), "p.ply");
+    assert_eq!(
+        (p["points"].as_u64(), p["normals"].as_bool()),
+        (Some(2), Some(false))
+    );
+}
+
+#[test]
+fn info_on_bunny_scan_reports_40097_points() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/scans/bun045.ply");
+    if !path.exists() {
+        println!("note: {} not found, test skipped", path.display());
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = path.to_string_lossy().into_owned();
+    let text = ok(&subdyn(dir.path(), &["info", &path]));
+    assert!(text.contains("points:               40,097"), "{text}");
+    let json: Value =
+        serde_json::from_str(ok(&subdyn(dir.path(), &["info", &path, "--json"])).trim()).unwrap();
+    assert_eq!(json["points"], 40097);
+}
+
+#[test]
+fn info_bad_input_is_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "e.off", b"");
+    let out = subdyn(dir.path(), &["info", "e.off"]);
+    assert_clean_failure(dir.path(), &out, &["e.off", "empty"], &["e.off"]);
+}
+
+// ---------------------------------------------------------------- bench
+
+#[test]
+fn bench_subdivide_prints_json_last_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = ok(&subdyn(
+        dir.path(),
+        &["bench", "subdivide", "--grid", "8", "--levels", "1"],
+    ));
+    let last = out.lines().last().expect("some output");
+    let json: Value = serde_json::from_str(last).expect("the last line is JSON");
+    for key in [
+        "topology_s",
+        "refine_s",
+        "stencil_build_s",
+        "stencil_apply_s",
+    ] {
+        assert!(
+            json[key].as_f64().is_some_and(|s| s >= 0.0),
+            "{key} in {last}"
+        );
+    }
+    assert_eq!(json["vertices"], 256);
+    assert_eq!(json["faces"], 256);
+    assert!(json["max_abs_diff"].as_f64().unwrap() < 1e-12);
+    assert_eq!(json["opensubdiv_reference"]["stencil_build_s"], 1.4);
+    assert!(out.contains("stencil apply"), "human-readable table: {out}");
+    assert!(files(dir.path()).is_empty());
+}
