@@ -1,13 +1,7 @@
 //! Closest points on the limit surface: the spring-force engine of fitting.
 //!
-//! Precompute: the control mesh is refined uniformly to level `L` (default 2);
-//! every level-`L` face whose corners are regular becomes a bicubic B-spline
-//! patch with 16 control points (exactly the limit surface over that face).
-//! A face that touches an irregular vertex is, on first use, subdivided
-//! locally into a quadtree of regular bicubic leaves, [`TREE_DEPTH`] levels
-//! deep; only the innermost cell at the irregular vertex is evaluated through
-//! [`LimitEvaluator`]. Each face is sampled on a small grid and the samples go
-//! into a k-d tree.
+//! Precompute: a [`PatchTable`] at level `L` (default 2); each patch is
+//! sampled on a small grid and the samples go into a k-d tree.
 //!
 //! Query: the nearest samples seed a projected Newton iteration on
 //! `½‖P(s, t) − q‖²` inside a level-`L` face, with a Gauss-Newton fallback
@@ -16,20 +10,18 @@
 //! The result is reported as a base-face sample `(face, u, v)`.
 
 use std::num::NonZero;
-use std::sync::OnceLock;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::math::{Point3, Real, Vector3, bbox_diagonal};
-use crate::subdivision::{Hierarchy, Refiner};
-use crate::topology::{Level, NONE};
+use crate::subdivision::Refiner;
+use crate::topology::NONE;
 
-use super::bspline::patch_weights;
-use super::patch::{CORNERS, LocalPatch, patch_grid};
-use super::vertex_masks::{CornerKind, corner_kind};
-use super::{LimitEvaluator, Sample};
+use super::Sample;
+use super::patch::CORNERS;
+use super::patch_table::{PatchPoint, PatchTable};
 
 /// Options of [`ClosestPointEngine::new`].
 #[derive(Clone, Debug)]
@@ -68,44 +60,9 @@ pub struct ClosestPoint {
     pub normal: Vector3,
 }
 
-/// Levels of local subdivision below `L` for faces at irregular vertices.
-pub const TREE_DEPTH: usize = 8;
-
-/// A level-`L` face: its limit patch and its place in its base face.
-struct Patch {
-    /// Control points of the bicubic patch, or `None` near an irregular vertex.
-    grid: Option<[Point3; 16]>,
-    /// Regular leaves of the local subdivision of an irregular face (lazy).
-    tree: OnceLock<Vec<Leaf>>,
-    base: u32,
-    /// Base `(u, v) = origin + axes · (s, t)`.
-    origin: [Real; 2],
-    axes: [[Real; 2]; 2],
-}
-
-/// A cell of an irregular face's quadtree: leaf `(s', t') = J (s, t) + c`
-/// in the face's `(s, t)`, with its bicubic control points (`None` for the
-/// innermost cell at an irregular vertex, evaluated exactly).
-struct Leaf {
-    jac: [[Real; 2]; 2],
-    off: [Real; 2],
-    grid: Option<[Point3; 16]>,
-}
-
-/// Position and first/second derivatives in a patch's own `(s, t)`.
-struct Eval {
-    p: Point3,
-    d: [Vector3; 5],
-}
-
 /// Closest-point queries against the limit surface of a fixed control mesh.
 pub struct ClosestPointEngine {
-    evaluator: LimitEvaluator,
-    positions: Vec<Point3>,
-    level: Level,
-    sharp: crate::topology::Sharpness,
-    level_positions: Vec<Point3>,
-    patches: Vec<Patch>,
+    table: PatchTable,
     seeds: Vec<(u32, [Real; 2])>,
     tree: ImmutableKdTree<Real, 3>,
     params: ClosestPointParams,
@@ -140,52 +97,15 @@ impl ClosestPointEngine {
         if refiner.level.num_faces() == 0 {
             return Err(Error::Input("the control mesh has no faces".into()));
         }
-        let h = refiner.refine_uniform(params.level)?;
-        let evaluator = LimitEvaluator::new(refiner);
-        let pl = h.refine_positions(positions)?;
-        let lp = &pl[params.level];
-        let fine = h.finest();
-        let sharp = h.sharpness.last().expect("levels exist");
-        let maps = param_maps(&h);
-        let patches: Vec<Patch> = (0..fine.num_faces())
-            .into_par_iter()
-            .map(|f| {
-                let regular = fine.face_vertices(f).iter().all(|&c| {
-                    corner_kind(fine, sharp, c as usize, f as u32) != CornerKind::Irregular
-                });
-                let grid = regular.then(|| {
-                    patch_grid(fine, sharp, f).map(|b| {
-                        Point3::from(
-                            b.entries()
-                                .map(|(c, w)| w * lp[c as usize].coords)
-                                .sum::<Vector3>(),
-                        )
-                    })
-                });
-                let (base, origin, axes) = maps[f];
-                Patch {
-                    grid,
-                    tree: OnceLock::new(),
-                    base,
-                    origin,
-                    axes,
-                }
-            })
-            .collect();
         let mut engine = ClosestPointEngine {
-            evaluator,
-            positions: positions.to_vec(),
-            level: fine.clone(),
-            sharp: sharp.clone(),
-            level_positions: lp.clone(),
-            patches,
+            table: PatchTable::new(refiner, positions, params.level)?,
             seeds: Vec::new(),
             tree: ImmutableKdTree::new_from_slice(&[[0.0; 3]]),
             params: params.clone(),
             scale: bbox_diagonal(positions).max(Real::MIN_POSITIVE),
         };
         let n = params.seeds_per_side;
-        let seeds: Vec<(u32, [Real; 2])> = (0..engine.patches.len() as u32)
+        let seeds: Vec<(u32, [Real; 2])> = (0..engine.table.num_patches() as u32)
             .flat_map(|f| {
                 (0..n * n).map(move |i| {
                     let s = ((i % n) as Real + 0.5) / n as Real;
@@ -196,72 +116,16 @@ impl ClosestPointEngine {
             .collect();
         let pts: Vec<[Real; 3]> = seeds
             .par_iter()
-            .map(|&(f, st)| engine.eval(f as usize, st).map(|e| [e.p.x, e.p.y, e.p.z]))
+            .map(|&(f, st)| {
+                engine
+                    .table
+                    .eval(f as usize, st)
+                    .map(|e| [e.p.x, e.p.y, e.p.z])
+            })
             .collect::<Result<_>>()?;
         engine.tree = ImmutableKdTree::new_from_slice(&pts);
         engine.seeds = seeds;
         Ok(engine)
-    }
-
-    /// Evaluates patch `f` at `(s, t)`: position and `∂s, ∂t, ∂ss, ∂st, ∂tt`.
-    fn eval(&self, f: usize, st: [Real; 2]) -> Result<Eval> {
-        let patch = &self.patches[f];
-        if let Some(grid) = &patch.grid {
-            let w = patch_weights(st[0], st[1]);
-            let q: [Vector3; 6] =
-                std::array::from_fn(|k| (0..16).map(|i| w[k][i] * grid[i].coords).sum());
-            return Ok(Eval {
-                p: Point3::from(q[0]),
-                d: [q[1], q[2], q[3], q[4], q[5]],
-            });
-        }
-        let leaves = patch.tree.get_or_init(|| self.leaves(f));
-        let inside = |l: &&Leaf| {
-            let x = l.jac[0][0] * st[0] + l.jac[0][1] * st[1] + l.off[0];
-            let y = l.jac[1][0] * st[0] + l.jac[1][1] * st[1] + l.off[1];
-            (-1e-12..=1.0 + 1e-12).contains(&x) && (-1e-12..=1.0 + 1e-12).contains(&y)
-        };
-        if let Some(leaf) = leaves.iter().filter(|l| l.grid.is_some()).find(inside) {
-            let j = leaf.jac;
-            let x = [
-                (j[0][0] * st[0] + j[0][1] * st[1] + leaf.off[0]).clamp(0.0, 1.0),
-                (j[1][0] * st[0] + j[1][1] * st[1] + leaf.off[1]).clamp(0.0, 1.0),
-            ];
-            let grid = leaf.grid.as_ref().expect("filtered");
-            let w = patch_weights(x[0], x[1]);
-            let q: [Vector3; 6] =
-                std::array::from_fn(|k| (0..16).map(|i| w[k][i] * grid[i].coords).sum());
-            // (s', t') = J (s, t) + c: first and second derivatives by the chain rule.
-            let (su, sv, tu, tv) = (j[0][0], j[0][1], j[1][0], j[1][1]);
-            return Ok(Eval {
-                p: Point3::from(q[0]),
-                d: [
-                    q[1] * su + q[2] * tu,
-                    q[1] * sv + q[2] * tv,
-                    q[3] * su * su + q[4] * (2.0 * su * tu) + q[5] * tu * tu,
-                    q[3] * su * sv + q[4] * (su * tv + sv * tu) + q[5] * tu * tv,
-                    q[3] * sv * sv + q[4] * (2.0 * sv * tv) + q[5] * tv * tv,
-                ],
-            });
-        }
-        let a = patch.axes;
-        let u = patch.origin[0] + a[0][0] * st[0] + a[0][1] * st[1];
-        let v = patch.origin[1] + a[1][0] * st[0] + a[1][1] * st[1];
-        let e = self
-            .evaluator
-            .evaluate(patch.base as usize, u, v, &self.positions)?;
-        // (u, v) = o + A (s, t): chain rule.
-        let (us, ut, vs, vt) = (a[0][0], a[0][1], a[1][0], a[1][1]);
-        Ok(Eval {
-            p: e.p,
-            d: [
-                e.du * us + e.dv * vs,
-                e.du * ut + e.dv * vt,
-                e.duu * us * us + e.duv * (2.0 * us * vs) + e.dvv * vs * vs,
-                e.duu * us * ut + e.duv * (us * vt + ut * vs) + e.dvv * vs * vt,
-                e.duu * ut * ut + e.duv * (2.0 * ut * vt) + e.dvv * vt * vt,
-            ],
-        })
     }
 
     /// The closest limit-surface point to `q`.
@@ -275,7 +139,7 @@ impl ClosestPointEngine {
         let k = NonZero::new(self.params.candidates.min(self.seeds.len()))
             .unwrap_or(NonZero::<usize>::MIN);
         let near = self.tree.nearest_n::<SquaredEuclidean>(&[q.x, q.y, q.z], k);
-        let mut best: Option<(Real, usize, [Real; 2], Eval)> = None;
+        let mut best: Option<(Real, usize, [Real; 2], PatchPoint)> = None;
         for nn in near {
             let (f, st) = self.seeds[nn.item as usize];
             let (f, st, e) = self.descend(q, f as usize, st)?;
@@ -285,96 +149,16 @@ impl ClosestPointEngine {
             }
         }
         let (d, f, st, e) = best.ok_or_else(|| Error::Input("no seed found".into()))?;
-        let p = &self.patches[f];
-        let a = p.axes;
-        let n = e.d[0].cross(&e.d[1]);
         // Orientation of (s, t) relative to (u, v) decides the normal's sign.
-        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-        let normal = (n * det.signum())
+        let normal = (e.d[0].cross(&e.d[1]) * self.table.orientation(f))
             .try_normalize(0.0)
             .unwrap_or_else(Vector3::zeros);
         Ok(ClosestPoint {
-            sample: Sample {
-                face: p.base,
-                u: p.origin[0] + a[0][0] * st[0] + a[0][1] * st[1],
-                v: p.origin[1] + a[1][0] * st[0] + a[1][1] * st[1],
-            },
+            sample: self.table.sample(f, st),
             point: e.p,
             distance: d,
             normal,
         })
-    }
-
-    /// Quadtree leaves of irregular level-`L` face `f` (see module docs).
-    fn leaves(&self, f: usize) -> Vec<Leaf> {
-        let positions = |rows: [Vec<Real>; 16], cols: &[u32]| -> [Point3; 16] {
-            rows.map(|r| {
-                Point3::from(
-                    r.iter()
-                        .zip(cols)
-                        .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
-                        .sum::<Vector3>(),
-                )
-            })
-        };
-        let mut leaves = Vec::new();
-        let mut stack = vec![(
-            LocalPatch::around(&self.level, &self.sharp, f),
-            [[1.0, 0.0], [0.0, 1.0]],
-            [0.0, 0.0],
-            0,
-        )];
-        while let Some((patch, jac, off, depth)) = stack.pop() {
-            if depth == TREE_DEPTH {
-                leaves.push(Leaf {
-                    jac,
-                    off,
-                    grid: None,
-                });
-                continue;
-            }
-            let refined = patch.refined();
-            for k in 0..4 {
-                // Child k: corner 0 at corner k, s' towards corner k+1, t' towards k−1.
-                let o = CORNERS[k];
-                let a = [
-                    CORNERS[(k + 1) % 4][0] - o[0],
-                    CORNERS[(k + 1) % 4][1] - o[1],
-                ];
-                let b = [
-                    CORNERS[(k + 3) % 4][0] - o[0],
-                    CORNERS[(k + 3) % 4][1] - o[1],
-                ];
-                let m = [[2.0 * a[0], 2.0 * a[1]], [2.0 * b[0], 2.0 * b[1]]];
-                let cj = [
-                    [
-                        m[0][0] * jac[0][0] + m[0][1] * jac[1][0],
-                        m[0][0] * jac[0][1] + m[0][1] * jac[1][1],
-                    ],
-                    [
-                        m[1][0] * jac[0][0] + m[1][1] * jac[1][0],
-                        m[1][0] * jac[0][1] + m[1][1] * jac[1][1],
-                    ],
-                ];
-                let d = [off[0] - o[0], off[1] - o[1]];
-                let co = [
-                    m[0][0] * d[0] + m[0][1] * d[1],
-                    m[1][0] * d[0] + m[1][1] * d[1],
-                ];
-                let cf = patch.child_face(k);
-                if refined.is_regular(cf) {
-                    let grid = positions(refined.grid_rows(cf), &refined.cols);
-                    leaves.push(Leaf {
-                        jac: cj,
-                        off: co,
-                        grid: Some(grid),
-                    });
-                } else {
-                    stack.push((refined.extract(cf), cj, co, depth + 1));
-                }
-            }
-        }
-        leaves
     }
 
     /// Closest points of many queries, in parallel.
@@ -388,8 +172,8 @@ impl ClosestPointEngine {
         q: Point3,
         mut f: usize,
         mut st: [Real; 2],
-    ) -> Result<(usize, [Real; 2], Eval)> {
-        let mut e = self.eval(f, st)?;
+    ) -> Result<(usize, [Real; 2], PatchPoint)> {
+        let mut e = self.table.eval(f, st)?;
         let mut crossings = 0;
         let tol = 1e-13;
         for _ in 0..self.params.max_iterations {
@@ -438,7 +222,7 @@ impl ClosestPointEngine {
                     (st[0] + a * step[0]).clamp(0.0, 1.0),
                     (st[1] + a * step[1]).clamp(0.0, 1.0),
                 ];
-                let ce = self.eval(f, cand)?;
+                let ce = self.table.eval(f, cand)?;
                 if (ce.p - q).norm_squared() <= d0 {
                     accepted = Some((cand, ce, a));
                     break;
@@ -456,7 +240,7 @@ impl ClosestPointEngine {
             {
                 f = g;
                 st = gst;
-                e = self.eval(f, st)?;
+                e = self.table.eval(f, st)?;
                 crossings += 1;
                 continue;
             }
@@ -469,7 +253,7 @@ impl ClosestPointEngine {
 
     /// The same surface point seen from the patch across edge `k` of patch `f`.
     fn across(&self, f: usize, k: usize, st: [Real; 2]) -> Option<(usize, [Real; 2])> {
-        let l = &self.level;
+        let l = self.table.level();
         let e = l.face_edge_list(f)[k] as usize;
         let [f0, f1] = l.edge_faces[e];
         let g = if f0 as usize == f { f1 } else { f0 };
@@ -513,57 +297,4 @@ fn solve_spd(h: [Real; 3], g: [Real; 2]) -> Option<[Real; 2]> {
         (-g[0] * h[2] + g[1] * h[1]) / det,
         (g[0] * h[1] - g[1] * h[0]) / det,
     ])
-}
-
-/// For every face of the finest level: its base face and the affine map from
-/// its `(s, t)` to the base face's `(u, v)`.
-fn param_maps(h: &Hierarchy) -> Vec<(u32, [Real; 2], [[Real; 2]; 2])> {
-    let l0 = h.level(0);
-    let mut maps: Vec<(u32, [Real; 2], [[Real; 2]; 2])> = (0..l0.num_faces() as u32)
-        .map(|f| (f, [0.0, 0.0], [[1.0, 0.0], [0.0, 1.0]]))
-        .collect();
-    for k in 0..h.num_levels() {
-        let parent = h.level(k);
-        let mut next = Vec::with_capacity(parent.face_verts.len());
-        for (f, &(base, o, a)) in maps.iter().enumerate() {
-            let n = parent.face_vertices(f).len();
-            for i in 0..n {
-                if n != 4 {
-                    // n-gon sub-face i: its tile, at half scale (only at level 0).
-                    let d = (n as Real).sqrt().ceil() as usize;
-                    next.push((
-                        base,
-                        [(i % d) as Real, (i / d) as Real],
-                        [[0.5, 0.0], [0.0, 0.5]],
-                    ));
-                    continue;
-                }
-                // Child i: corner 0 at parent corner i, s towards i+1, t towards i−1.
-                let c = CORNERS[i];
-                let ax = [
-                    CORNERS[(i + 1) % 4][0] - c[0],
-                    CORNERS[(i + 1) % 4][1] - c[1],
-                ];
-                let bx = [
-                    CORNERS[(i + 3) % 4][0] - c[0],
-                    CORNERS[(i + 3) % 4][1] - c[1],
-                ];
-                // parent (s, t) = c + ½ (ax s' + bx t'); base = o + a · parent.
-                let po = [
-                    o[0] + a[0][0] * c[0] + a[0][1] * c[1],
-                    o[1] + a[1][0] * c[0] + a[1][1] * c[1],
-                ];
-                let col = |v: [Real; 2]| {
-                    [
-                        0.5 * (a[0][0] * v[0] + a[0][1] * v[1]),
-                        0.5 * (a[1][0] * v[0] + a[1][1] * v[1]),
-                    ]
-                };
-                let (cs, ct) = (col(ax), col(bx));
-                next.push((base, po, [[cs[0], ct[0]], [cs[1], ct[1]]]));
-            }
-        }
-        maps = next;
-    }
-    maps
 }

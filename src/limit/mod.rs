@@ -6,6 +6,7 @@ mod closest;
 mod evaluator;
 mod limit_stencil;
 mod patch;
+mod patch_table;
 mod tessellate;
 mod vertex_masks;
 
@@ -14,5 +15,6 @@ pub use closest::{ClosestPoint, ClosestPointEngine, ClosestPointParams};
 pub use evaluator::{LimitEvaluator, LimitPoint, LimitStencils, Sample};
 pub use limit_stencil::limit_stencil;
 pub use patch::SampleStencil;
+pub use patch_table::{PatchPoint, PatchTable, TREE_DEPTH};
 pub use tessellate::tessellate;
 pub use vertex_masks::CornerKind;

@@ -19,6 +19,7 @@ use crate::subdivision::{refine_stencil, refine_topology};
 use crate::topology::{Level, SHARPNESS_INFINITE, Sharpness, find_edge};
 
 use super::bspline::patch_weights;
+use super::patch_table::chain;
 use super::vertex_masks::{
     CornerKind, corner_kind, corner_tangents, limit_position_mask, masks_apply,
 };
@@ -232,21 +233,13 @@ pub fn evaluate_face(
 ) -> SampleStencil {
     let mut patch = LocalPatch::around(level, sharp, face);
     let n = level.face_vertices(face).len();
-    // (s, t) = a · (u, v) + offset with a = jac (2×2), tracked for the chain rule.
+    // (s, t) = jac · (u, v) + offset, tracked for the chain rule.
     let mut st = [u.clamp(0.0, 1.0), v.clamp(0.0, 1.0)];
     let mut jac = [[1.0, 0.0], [0.0, 1.0]];
     let mut depth = 0;
     if n != 4 {
-        let d = (n as Real).sqrt().ceil() as usize;
-        let rows = n.div_ceil(d);
-        let tu = ((u + 0.25).floor().max(0.0) as usize).min(d - 1);
-        let tv = ((v + 0.25).floor().max(0.0) as usize).min(rows - 1);
-        let i = (tv * d + tu).min(n - 1);
-        let (tu, tv) = ((i % d) as Real, (i / d) as Real);
-        st = [
-            (2.0 * (u - tu)).clamp(0.0, 1.0),
-            (2.0 * (v - tv)).clamp(0.0, 1.0),
-        ];
+        let (i, sub) = subface(n, u, v);
+        st = sub;
         jac = [[2.0, 0.0], [0.0, 2.0]];
         patch.descend(i);
         depth = 1;
@@ -281,36 +274,80 @@ pub fn evaluate_face(
                 return irregular_corner(&patch, c, k, jac);
             }
         }
-        // Descend into the quadrant holding (s, t); ties go up, as in Bfr.
-        let k = match (st[0] >= 0.5, st[1] >= 0.5) {
-            (false, false) => 0,
-            (true, false) => 1,
-            (true, true) => 2,
-            (false, true) => 3,
-        };
-        // Child k: corner 0 at parent corner k, s towards corner k+1, t towards k−1.
-        let o = CORNERS[k];
-        let a = sub(CORNERS[(k + 1) % 4], o);
-        let b = sub(CORNERS[(k + 3) % 4], o);
-        let d = sub(st, o);
-        st = [
-            (2.0 * (d[0] * a[0] + d[1] * a[1])).clamp(0.0, 1.0),
-            (2.0 * (d[0] * b[0] + d[1] * b[1])).clamp(0.0, 1.0),
-        ];
-        // new jac rows: 2 a·jac, 2 b·jac
-        jac = [
-            [
-                2.0 * (a[0] * jac[0][0] + a[1] * jac[1][0]),
-                2.0 * (a[0] * jac[0][1] + a[1] * jac[1][1]),
-            ],
-            [
-                2.0 * (b[0] * jac[0][0] + b[1] * jac[1][0]),
-                2.0 * (b[0] * jac[0][1] + b[1] * jac[1][1]),
-            ],
-        ];
+        let k = quadrant(st);
+        let (child, m) = child_frame(k, st);
+        st = child;
+        jac = mat_mul(m, jac);
         patch.descend(k);
         depth += 1;
     }
+}
+
+/// The quadrant of `(s, t)`: the child at corner 0, 1, 2 or 3. Ties go to
+/// the upper half, as in OpenSubdiv's `Bfr`.
+pub(crate) fn quadrant(st: [Real; 2]) -> usize {
+    match (st[0] >= 0.5, st[1] >= 0.5) {
+        (false, false) => 0,
+        (true, false) => 1,
+        (true, true) => 2,
+        (false, true) => 3,
+    }
+}
+
+/// Child `k` of a quad has its corner 0 at the parent's corner `k`, `s`
+/// towards corner `k + 1` and `t` towards corner `k − 1` (the refiner's child
+/// order). Returns the child's `(s, t)` for the parent's `st` and the matrix
+/// `M` with `child = M (st − corner_k)`.
+pub(crate) fn child_frame(k: usize, st: [Real; 2]) -> ([Real; 2], [[Real; 2]; 2]) {
+    let o = CORNERS[k];
+    let a = sub(CORNERS[(k + 1) % 4], o);
+    let b = sub(CORNERS[(k + 3) % 4], o);
+    let m = [[2.0 * a[0], 2.0 * a[1]], [2.0 * b[0], 2.0 * b[1]]];
+    let d = sub(st, o);
+    let c = mat_vec(m, d);
+    ([c[0].clamp(0.0, 1.0), c[1].clamp(0.0, 1.0)], m)
+}
+
+/// Sub-face of an `n`-gon holding `(u, v)` and the sub-face's own `(s, t)`:
+/// sub-face `i` covers `[tu, tu + ½] × [tv, tv + ½]`, `(tu, tv) = (i mod d,
+/// i div d)`, `d = ⌈√n⌉`; values past three quarters of a tile count for
+/// the next tile, as in `Bfr`.
+pub(crate) fn subface(n: usize, u: Real, v: Real) -> (usize, [Real; 2]) {
+    let d = (n as Real).sqrt().ceil() as usize;
+    let rows = n.div_ceil(d);
+    let tu = ((u + 0.25).floor().max(0.0) as usize).min(d - 1);
+    let tv = ((v + 0.25).floor().max(0.0) as usize).min(rows - 1);
+    let i = (tv * d + tu).min(n - 1);
+    let (tu, tv) = ((i % d) as Real, (i / d) as Real);
+    (
+        i,
+        [
+            (2.0 * (u - tu)).clamp(0.0, 1.0),
+            (2.0 * (v - tv)).clamp(0.0, 1.0),
+        ],
+    )
+}
+
+/// `a · b` for 2×2 matrices.
+pub(crate) fn mat_mul(a: [[Real; 2]; 2], b: [[Real; 2]; 2]) -> [[Real; 2]; 2] {
+    [
+        [
+            a[0][0] * b[0][0] + a[0][1] * b[1][0],
+            a[0][0] * b[0][1] + a[0][1] * b[1][1],
+        ],
+        [
+            a[1][0] * b[0][0] + a[1][1] * b[1][0],
+            a[1][0] * b[0][1] + a[1][1] * b[1][1],
+        ],
+    ]
+}
+
+/// `a · x` for a 2×2 matrix.
+pub(crate) fn mat_vec(a: [[Real; 2]; 2], x: [Real; 2]) -> [Real; 2] {
+    [
+        a[0][0] * x[0] + a[0][1] * x[1],
+        a[1][0] * x[0] + a[1][1] * x[1],
+    ]
 }
 
 fn sub(a: [Real; 2], b: [Real; 2]) -> [Real; 2] {
@@ -422,17 +459,14 @@ fn regular_patch(patch: &LocalPatch, st: [Real; 2], jac: [[Real; 2]; 2]) -> Samp
 /// Maps `(P, Ps, Pt, Pss, Pst, Ptt)` to `(P, Pu, Pv, Puu, Puv, Pvv)` with
 /// `(s, t) = J (u, v) + c`.
 fn chain_rule(patch: &LocalPatch, local: [Vec<Real>; 6], j: [[Real; 2]; 2]) -> SampleStencil {
-    let (su, sv, tu, tv) = (j[0][0], j[0][1], j[1][0], j[1][1]);
     let nc = patch.ncols();
     let mut out: [Vec<Real>; 6] = std::array::from_fn(|_| vec![0.0; nc]);
     for i in 0..nc {
-        let [p, ps, pt, pss, pst, ptt] = [0, 1, 2, 3, 4, 5].map(|q| local[q][i]);
-        out[0][i] = p;
-        out[1][i] = ps * su + pt * tu;
-        out[2][i] = ps * sv + pt * tv;
-        out[3][i] = pss * su * su + 2.0 * pst * su * tu + ptt * tu * tu;
-        out[4][i] = pss * su * sv + pst * (su * tv + sv * tu) + ptt * tu * tv;
-        out[5][i] = pss * sv * sv + 2.0 * pst * sv * tv + ptt * tv * tv;
+        out[0][i] = local[0][i];
+        let d = chain([1, 2, 3, 4, 5].map(|q| local[q][i]), j);
+        for q in 0..5 {
+            out[q + 1][i] = d[q];
+        }
     }
     SampleStencil {
         cols: patch.cols.clone(),

@@ -9,7 +9,7 @@ use crate::math::{Point3, Real, Vector3};
 use crate::mesh::PolyMesh;
 use crate::subdivision::Refiner;
 
-use super::LimitEvaluator;
+use super::PatchTable;
 
 /// A point of the control mesh's topology that samples can share.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -77,7 +77,7 @@ pub fn tessellate(
             level.num_vertices
         )));
     }
-    let eval = LimitEvaluator::new(refiner);
+    let table = PatchTable::new(refiner, positions, 2)?;
     let split = (0..level.num_faces()).any(|f| level.face_vertices(f).len() != 4);
     let mut tiles = Vec::new();
     for f in 0..level.num_faces() {
@@ -127,7 +127,7 @@ pub fn tessellate(
                 for a in 0..=k {
                     let u = t.origin[0] + t.size * a as Real / k as Real;
                     let v = t.origin[1] + t.size * b as Real / k as Real;
-                    let s = eval.evaluate(t.face as usize, u, v, positions)?;
+                    let s = table.evaluate(t.face as usize, u, v)?;
                     g.push((s.p, s.normal()));
                 }
             }

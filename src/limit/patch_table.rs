@@ -1,0 +1,369 @@
+//! `PatchTable`: the limit surface of a fixed control mesh as bicubic patches.
+//!
+//! The control mesh is refined uniformly to level `L`; every level-`L` face
+//! whose corners are regular becomes a bicubic B-spline patch with 16 control
+//! points, which is exactly the limit surface over that face. A face that
+//! touches an irregular vertex is, on first use, subdivided locally into a
+//! quadtree of regular bicubic leaves [`TREE_DEPTH`] levels deep; only the
+//! innermost cell at the irregular vertex is evaluated through
+//! [`LimitEvaluator`] (OpenSubdiv's feature-adaptive patch tables rest on the
+//! same observation, Nießner et al. 2012). Evaluation is then a 16-point
+//! product almost everywhere.
+
+use std::ops::{Add, Mul};
+use std::sync::OnceLock;
+
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::math::{Point3, Real, Vector3};
+use crate::subdivision::{Hierarchy, Refiner};
+use crate::topology::{Level, Sharpness};
+
+use super::bspline::patch_weights;
+use super::patch::{CORNERS, LocalPatch, child_frame, mat_mul, mat_vec, patch_grid, quadrant};
+use super::vertex_masks::{CornerKind, corner_kind};
+use super::{LimitEvaluator, LimitPoint, Sample};
+
+/// Levels of local subdivision below `L` for faces at irregular vertices.
+pub const TREE_DEPTH: usize = 6;
+
+/// A level-`L` face: its limit patch and its place in its base face.
+struct Patch {
+    /// Control points of the bicubic patch, or `None` near an irregular vertex.
+    grid: Option<[Point3; 16]>,
+    /// Regular leaves of the local subdivision of an irregular face (lazy).
+    tree: OnceLock<Vec<Leaf>>,
+    base: u32,
+    /// Base `(u, v) = origin + axes · (s, t)`.
+    origin: [Real; 2],
+    axes: [[Real; 2]; 2],
+}
+
+/// A cell of an irregular face's quadtree: leaf `(s', t') = J (s, t) + c`
+/// in the face's `(s, t)`, with its bicubic control points (`None` for the
+/// innermost cell at an irregular vertex, evaluated exactly).
+struct Leaf {
+    jac: [[Real; 2]; 2],
+    off: [Real; 2],
+    grid: Option<[Point3; 16]>,
+}
+
+/// Position and derivatives `∂s, ∂t, ∂ss, ∂st, ∂tt` in a patch's own `(s, t)`.
+#[derive(Clone, Copy, Debug)]
+pub struct PatchPoint {
+    /// Position.
+    pub p: Point3,
+    /// `[Ps, Pt, Pss, Pst, Ptt]`.
+    pub d: [Vector3; 5],
+}
+
+/// The limit surface of one control mesh (fixed positions) as level-`L` patches.
+pub struct PatchTable {
+    evaluator: LimitEvaluator,
+    positions: Vec<Point3>,
+    level: Level,
+    sharp: Sharpness,
+    level_positions: Vec<Point3>,
+    /// Face offsets of levels `0..L`, to locate a base `(face, u, v)`.
+    offsets: Vec<Vec<u32>>,
+    patches: Vec<Patch>,
+}
+
+impl PatchTable {
+    /// Refines to `level` (1 to 6) and builds the regular patches.
+    pub fn new(refiner: &Refiner, positions: &[Point3], level: usize) -> Result<PatchTable> {
+        if level == 0 || level > 6 {
+            return Err(Error::Input(format!(
+                "patch level {level} must be between 1 and 6"
+            )));
+        }
+        if positions.len() != refiner.level.num_vertices {
+            return Err(Error::Input(format!(
+                "{} positions for a mesh of {} vertices",
+                positions.len(),
+                refiner.level.num_vertices
+            )));
+        }
+        let h = refiner.refine_uniform(level)?;
+        let mut pl = h.refine_positions(positions)?;
+        let lp = pl.pop().expect("levels exist");
+        let fine = h.finest();
+        let sharp = h.sharpness.last().expect("levels exist");
+        let maps = param_maps(&h);
+        let patches = (0..fine.num_faces())
+            .into_par_iter()
+            .map(|f| {
+                let regular = fine.face_vertices(f).iter().all(|&c| {
+                    corner_kind(fine, sharp, c as usize, f as u32) != CornerKind::Irregular
+                });
+                let grid = regular.then(|| {
+                    patch_grid(fine, sharp, f).map(|b| {
+                        Point3::from(
+                            b.entries()
+                                .map(|(c, w)| w * lp[c as usize].coords)
+                                .sum::<Vector3>(),
+                        )
+                    })
+                });
+                let (base, origin, axes) = maps[f];
+                Patch {
+                    grid,
+                    tree: OnceLock::new(),
+                    base,
+                    origin,
+                    axes,
+                }
+            })
+            .collect();
+        Ok(PatchTable {
+            evaluator: LimitEvaluator::new(refiner),
+            positions: positions.to_vec(),
+            level: fine.clone(),
+            sharp: sharp.clone(),
+            level_positions: lp,
+            offsets: h.levels[..level]
+                .iter()
+                .map(|l| l.face_offsets.clone())
+                .collect(),
+            patches,
+        })
+    }
+
+    /// Number of patches (faces of level `L`).
+    pub fn num_patches(&self) -> usize {
+        self.patches.len()
+    }
+
+    /// Connectivity of level `L` (patch `f` is face `f`).
+    pub fn level(&self) -> &Level {
+        &self.level
+    }
+
+    /// Evaluates patch `f` at `(s, t) ∈ [0, 1]²`.
+    pub fn eval(&self, f: usize, st: [Real; 2]) -> Result<PatchPoint> {
+        let patch = &self.patches[f];
+        if let Some(grid) = &patch.grid {
+            return Ok(bicubic(grid, st));
+        }
+        let leaves = patch.tree.get_or_init(|| self.leaves(f));
+        let local = |l: &Leaf| {
+            [
+                l.jac[0][0] * st[0] + l.jac[0][1] * st[1] + l.off[0],
+                l.jac[1][0] * st[0] + l.jac[1][1] * st[1] + l.off[1],
+            ]
+        };
+        let inside = |x: [Real; 2]| x.iter().all(|c| (-1e-12..=1.0 + 1e-12).contains(c));
+        for leaf in leaves {
+            let x = local(leaf);
+            if let (Some(grid), true) = (&leaf.grid, inside(x)) {
+                let e = bicubic(grid, [x[0].clamp(0.0, 1.0), x[1].clamp(0.0, 1.0)]);
+                return Ok(PatchPoint {
+                    p: e.p,
+                    d: chain(e.d, leaf.jac),
+                });
+            }
+        }
+        let s = self.sample(f, st);
+        let e = self
+            .evaluator
+            .evaluate(s.face as usize, s.u, s.v, &self.positions)?;
+        Ok(PatchPoint {
+            p: e.p,
+            d: chain([e.du, e.dv, e.duu, e.duv, e.dvv], patch.axes),
+        })
+    }
+
+    /// The base-face sample of patch `f` at `(s, t)`.
+    pub fn sample(&self, f: usize, st: [Real; 2]) -> Sample {
+        let p = &self.patches[f];
+        let a = p.axes;
+        Sample {
+            face: p.base,
+            u: p.origin[0] + a[0][0] * st[0] + a[0][1] * st[1],
+            v: p.origin[1] + a[1][0] * st[0] + a[1][1] * st[1],
+        }
+    }
+
+    /// Sign of the orientation of patch `f`'s `(s, t)` relative to its base
+    /// face's `(u, v)` (rotations keep it at +1).
+    pub fn orientation(&self, f: usize) -> Real {
+        let a = self.patches[f].axes;
+        (a[0][0] * a[1][1] - a[0][1] * a[1][0]).signum()
+    }
+
+    /// The patch and `(s, t)` holding base sample `(face, u, v)`; ties go to
+    /// the upper half as in the evaluator.
+    pub fn locate(&self, face: usize, u: Real, v: Real) -> (usize, [Real; 2]) {
+        let mut f = face;
+        let mut st = [u, v];
+        for (k, offs) in self.offsets.iter().enumerate() {
+            let n = (offs[f + 1] - offs[f]) as usize;
+            let i = if k == 0 && n != 4 {
+                let (i, sub) = super::patch::subface(n, u, v);
+                st = sub;
+                i
+            } else {
+                let q = quadrant(st);
+                st = child_frame(q, st).0;
+                q
+            };
+            f = offs[f] as usize + i;
+        }
+        (f, st)
+    }
+
+    /// Limit position and derivatives at base sample `(face, u, v)`.
+    pub fn evaluate(&self, face: usize, u: Real, v: Real) -> Result<LimitPoint> {
+        if face + 1 >= self.offsets[0].len() {
+            return Err(Error::Input(format!("face {face} out of range")));
+        }
+        let (f, st) = self.locate(face, u, v);
+        let e = self.eval(f, st)?;
+        // (s, t) = A⁻¹ ((u, v) − o): invert the patch axes for the chain rule.
+        let a = self.patches[f].axes;
+        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+        let inv = [
+            [a[1][1] / det, -a[0][1] / det],
+            [-a[1][0] / det, a[0][0] / det],
+        ];
+        let d = chain(e.d, inv);
+        Ok(LimitPoint {
+            p: e.p,
+            du: d[0],
+            dv: d[1],
+            duu: d[2],
+            duv: d[3],
+            dvv: d[4],
+        })
+    }
+
+    /// Quadtree leaves of irregular level-`L` face `f` (see module docs).
+    fn leaves(&self, f: usize) -> Vec<Leaf> {
+        let positions = |rows: [Vec<Real>; 16], cols: &[u32]| -> [Point3; 16] {
+            rows.map(|r| {
+                Point3::from(
+                    r.iter()
+                        .zip(cols)
+                        .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
+                        .sum::<Vector3>(),
+                )
+            })
+        };
+        let mut leaves = Vec::new();
+        let mut stack = vec![(
+            LocalPatch::around(&self.level, &self.sharp, f),
+            [[1.0, 0.0], [0.0, 1.0]],
+            [0.0, 0.0],
+            0,
+        )];
+        while let Some((patch, jac, off, depth)) = stack.pop() {
+            if depth == TREE_DEPTH {
+                leaves.push(Leaf {
+                    jac,
+                    off,
+                    grid: None,
+                });
+                continue;
+            }
+            let refined = patch.refined();
+            for k in 0..4 {
+                let (_, m) = child_frame(k, [0.0, 0.0]);
+                let cj = mat_mul(m, jac);
+                let o = CORNERS[k];
+                let co = mat_vec(m, [off[0] - o[0], off[1] - o[1]]);
+                let cf = patch.child_face(k);
+                if refined.is_regular(cf) {
+                    let grid = positions(refined.grid_rows(cf), &refined.cols);
+                    leaves.push(Leaf {
+                        jac: cj,
+                        off: co,
+                        grid: Some(grid),
+                    });
+                } else {
+                    stack.push((refined.extract(cf), cj, co, depth + 1));
+                }
+            }
+        }
+        leaves
+    }
+}
+
+/// Bicubic B-spline patch value and derivatives at `(s, t)`.
+fn bicubic(grid: &[Point3; 16], st: [Real; 2]) -> PatchPoint {
+    let w = patch_weights(st[0], st[1]);
+    let q: [Vector3; 6] = std::array::from_fn(|k| (0..16).map(|i| w[k][i] * grid[i].coords).sum());
+    PatchPoint {
+        p: Point3::from(q[0]),
+        d: [q[1], q[2], q[3], q[4], q[5]],
+    }
+}
+
+/// Chain rule for `(s', t') = J (s, t) + c`: maps `[Ps', Pt', Ps's', Ps't', Pt't']`
+/// to `[Ps, Pt, Pss, Pst, Ptt]`.
+pub(crate) fn chain<T>(d: [T; 5], j: [[Real; 2]; 2]) -> [T; 5]
+where
+    T: Copy + Mul<Real, Output = T> + Add<Output = T>,
+{
+    let (su, sv, tu, tv) = (j[0][0], j[0][1], j[1][0], j[1][1]);
+    [
+        d[0] * su + d[1] * tu,
+        d[0] * sv + d[1] * tv,
+        d[2] * (su * su) + d[3] * (2.0 * su * tu) + d[4] * (tu * tu),
+        d[2] * (su * sv) + d[3] * (su * tv + sv * tu) + d[4] * (tu * tv),
+        d[2] * (sv * sv) + d[3] * (2.0 * sv * tv) + d[4] * (tv * tv),
+    ]
+}
+
+/// For every face of the finest level: its base face and the affine map from
+/// its `(s, t)` to the base face's `(u, v)`.
+fn param_maps(h: &Hierarchy) -> Vec<(u32, [Real; 2], [[Real; 2]; 2])> {
+    let l0 = h.level(0);
+    let mut maps: Vec<(u32, [Real; 2], [[Real; 2]; 2])> = (0..l0.num_faces() as u32)
+        .map(|f| (f, [0.0, 0.0], [[1.0, 0.0], [0.0, 1.0]]))
+        .collect();
+    for k in 0..h.num_levels() {
+        let parent = h.level(k);
+        let mut next = Vec::with_capacity(parent.face_verts.len());
+        for (f, &(base, o, a)) in maps.iter().enumerate() {
+            let n = parent.face_vertices(f).len();
+            for i in 0..n {
+                if n != 4 {
+                    // n-gon sub-face i: its tile, at half scale (only at level 0).
+                    let d = (n as Real).sqrt().ceil() as usize;
+                    next.push((
+                        base,
+                        [(i % d) as Real, (i / d) as Real],
+                        [[0.5, 0.0], [0.0, 0.5]],
+                    ));
+                    continue;
+                }
+                // Child i: corner 0 at parent corner i, s towards i+1, t towards i−1.
+                let c = CORNERS[i];
+                let ax = [
+                    CORNERS[(i + 1) % 4][0] - c[0],
+                    CORNERS[(i + 1) % 4][1] - c[1],
+                ];
+                let bx = [
+                    CORNERS[(i + 3) % 4][0] - c[0],
+                    CORNERS[(i + 3) % 4][1] - c[1],
+                ];
+                // parent (s, t) = c + ½ (ax s' + bx t'); base = o + a · parent.
+                let po = [
+                    o[0] + a[0][0] * c[0] + a[0][1] * c[1],
+                    o[1] + a[1][0] * c[0] + a[1][1] * c[1],
+                ];
+                let col = |v: [Real; 2]| {
+                    [
+                        0.5 * (a[0][0] * v[0] + a[0][1] * v[1]),
+                        0.5 * (a[1][0] * v[0] + a[1][1] * v[1]),
+                    ]
+                };
+                let (cs, ct) = (col(ax), col(bx));
+                next.push((base, po, [[cs[0], ct[0]], [cs[1], ct[1]]]));
+            }
+        }
+        maps = next;
+    }
+    maps
+}
