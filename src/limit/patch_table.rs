@@ -267,10 +267,9 @@ impl PatchTable {
                 continue;
             }
             let refined = patch.refined();
-            for k in 0..4 {
+            for (k, o) in CORNERS.iter().enumerate() {
                 let (_, m) = child_frame(k, [0.0, 0.0]);
                 let cj = mat_mul(m, jac);
-                let o = CORNERS[k];
                 let co = mat_vec(m, [off[0] - o[0], off[1] - o[1]]);
                 let cf = patch.child_face(k);
                 if refined.is_regular(cf) {
