@@ -208,7 +208,8 @@ pub fn corner_tangents(
         }
         return (lead, trail);
     }
-    if n_inf == 0 {
+    if n_inf <= 1 && !ring.boundary {
+        // Smooth or dart: the interior formula (a dart is refined smoothly).
         let n = ring.faces.len();
         let nr = n as Real;
         let theta = 2.0 * PI / nr;

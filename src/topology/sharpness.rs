@@ -82,7 +82,9 @@ impl Sharpness {
                     "crease {k}: vertices {i} and {j} are not joined by an edge of the mesh"
                 ))
             })?;
-            edge[e] = s.min(SHARPNESS_INFINITE);
+            // Stored at single precision, as OpenSubdiv does, so that results
+            // agree with it bit for bit (2.3 is 2.2999999523…).
+            edge[e] = (s as f32 as Real).min(SHARPNESS_INFINITE);
         }
         for (e, s) in edge.iter_mut().enumerate() {
             if level.is_boundary_edge(e) {
