@@ -320,23 +320,30 @@ impl StencilTable {
         num_cols: usize,
         row: impl Fn(usize, &mut RowBuilder) + Sync,
     ) -> StencilTable {
-        let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<Real>)> = (0..num_rows.div_ceil(CHUNK))
-            .into_par_iter()
-            .map_init(RowBuilder::default, |b, ci| {
-                let (r0, r1) = (ci * CHUNK, ((ci + 1) * CHUNK).min(num_rows));
-                let mut lens = Vec::with_capacity(r1 - r0);
-                let mut idx = Vec::with_capacity(8 * (r1 - r0));
-                let mut wts = Vec::with_capacity(8 * (r1 - r0));
-                for r in r0..r1 {
-                    b.clear();
-                    row(r, b);
-                    lens.push(b.cols.len());
-                    idx.extend_from_slice(&b.cols);
-                    wts.extend_from_slice(&b.wts);
-                }
-                (lens, idx, wts)
-            })
-            .collect();
+        let chunk = |b: &mut RowBuilder, ci: usize| {
+            let (r0, r1) = (ci * CHUNK, ((ci + 1) * CHUNK).min(num_rows));
+            let mut lens = Vec::with_capacity(r1 - r0);
+            let mut idx = Vec::with_capacity(8 * (r1 - r0));
+            let mut wts = Vec::with_capacity(8 * (r1 - r0));
+            for r in r0..r1 {
+                b.clear();
+                row(r, b);
+                lens.push(b.cols.len());
+                idx.extend_from_slice(&b.cols);
+                wts.extend_from_slice(&b.wts);
+            }
+            (lens, idx, wts)
+        };
+        let nchunks = num_rows.div_ceil(CHUNK);
+        let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<Real>)> = if nchunks <= 1 {
+            let mut b = RowBuilder::default();
+            (0..nchunks).map(|ci| chunk(&mut b, ci)).collect()
+        } else {
+            (0..nchunks)
+                .into_par_iter()
+                .map_init(RowBuilder::default, chunk)
+                .collect()
+        };
         Self::from_chunks(num_cols, num_rows, chunks)
     }
 
