@@ -793,7 +793,6 @@ fn closest_point_is_no_farther_than_a_dense_tessellation() {
 }
 
 #[test]
-#[ignore = "bug: closest-point Newton stops at an open boundary instead of sliding along it"]
 fn closest_point_on_an_open_surface_is_no_farther_than_a_dense_tessellation() {
     check_against_tessellation(&reference_mesh("fan5_open"), "fan5_open");
 }
@@ -802,7 +801,6 @@ fn closest_point_on_an_open_surface_is_no_farther_than_a_dense_tessellation() {
 /// (face 2, u = 1, v ≈ 0.4325): the engine must reach it, where the
 /// derivative of the distance along the boundary vanishes.
 #[test]
-#[ignore = "bug: closest-point Newton stops at an open boundary instead of sliding along it"]
 fn closest_point_slides_along_an_open_boundary() {
     let mesh = reference_mesh("fan5_open");
     let r = default_refiner(&mesh);

@@ -189,6 +189,31 @@ impl ClosestPointEngine {
             ];
             let step = solve_spd(nh, g).or_else(|| solve_spd(gn, g));
             let Some(mut step) = step else { break };
+            // On a true boundary (no patch across), slide along it: drop the
+            // blocked component and take the 1-D Newton step along the edge.
+            for i in 0..2 {
+                let outward = (st[i] <= 0.0 && step[i] < 0.0) || (st[i] >= 1.0 && step[i] > 0.0);
+                let side = match (i, step[i] < 0.0) {
+                    (0, true) => 3,
+                    (0, false) => 1,
+                    (_, true) => 0,
+                    (_, false) => 2,
+                };
+                if outward && self.across(f, side, st).is_none() {
+                    let j = 1 - i;
+                    let (hn, hg) = if j == 0 {
+                        (nh[0], gn[0])
+                    } else {
+                        (nh[2], gn[2])
+                    };
+                    let h = if hn > 0.0 { hn } else { hg };
+                    step[i] = 0.0;
+                    step[j] = if h > 0.0 { -g[j] / h } else { 0.0 };
+                }
+            }
+            if step == [0.0, 0.0] {
+                break;
+            }
             // Limit the step to half a patch.
             let len = (step[0] * step[0] + step[1] * step[1]).sqrt();
             if len > 0.5 {
