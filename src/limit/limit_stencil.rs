@@ -3,20 +3,22 @@
 use crate::error::Result;
 use crate::stencil::StencilTable;
 use crate::subdivision::Hierarchy;
+use crate::topology::VertexRule;
 
 use super::patch::{CORNERS, evaluate_face};
 use super::vertex_masks::{limit_position_mask, masks_apply};
 
 /// Rows = limit positions of the vertices of level `level`, as weights over
 /// the level-0 control points. Where the vertex masks apply (quads around the
-/// vertex, no semi-sharp feature at it) the mask of `vertex_masks` is used;
-/// elsewhere the vertex is a corner of one of its faces and the limit point
+/// vertex, no semi-sharp feature at it, not a dart) the mask of
+/// `vertex_masks` is used; elsewhere the vertex is a corner of one of its faces and the limit point
 /// is evaluated there by local subdivision, which follows semi-sharp creases
 /// until they have decayed.
 pub fn limit_stencil(h: &Hierarchy, level: usize) -> Result<StencilTable> {
     let (lv, sh) = (h.level(level), &h.sharpness[level]);
     let rows = StencilTable::from_row_fn(lv.num_vertices, lv.num_vertices, |v, b| {
-        if lv.vertex_faces(v).is_empty() || masks_apply(lv, sh, v) {
+        let dart = sh.rule(lv, v) == VertexRule::Dart;
+        if lv.vertex_faces(v).is_empty() || (masks_apply(lv, sh, v) && !dart) {
             limit_position_mask(lv, sh, v, 1.0, b);
             return;
         }
