@@ -899,3 +899,53 @@ fn limit_is_continuous_at_a_dart_vertex() {
         near.normal()
     );
 }
+
+/// Vertex limit tangents: on a regular torus they are the patch derivatives
+/// at the corner; at a cube corner (valence 3) they span the symmetric
+/// tangent plane, normal to (1, 1, 1).
+#[test]
+fn vertex_limit_tangents_span_the_tangent_plane() {
+    use subdyn::limit::limit_tangent_stencils;
+    let torus = subdyn::examples::torus(8, 6, 1.0, 0.4);
+    let r = default_refiner(&torus);
+    let h = r.refine_uniform(1).unwrap();
+    let (t1, t2) = limit_tangent_stencils(&h, 0).unwrap();
+    let (a, b) = (
+        t1.apply(&torus.positions).unwrap(),
+        t2.apply(&torus.positions).unwrap(),
+    );
+    let eval = LimitEvaluator::new(&r);
+    for v in 0..torus.num_vertices() {
+        let f = r.level.vertex_ring(v).faces[0] as usize;
+        let i = torus.face(f).iter().position(|&x| x as usize == v).unwrap();
+        let c = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)][i];
+        let e = eval.evaluate(f, c.0, c.1, &torus.positions).unwrap();
+        // leading edge direction of corner i and trailing edge direction
+        let dirs = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)];
+        let (l, t) = (dirs[i], dirs[(i + 3) % 4]);
+        let want_a = e.du * l.0 + e.dv * l.1;
+        let want_b = -(e.du * t.0 + e.dv * t.1);
+        assert!(
+            (a[v].coords - want_a).norm() < 1e-12,
+            "vertex {v}: lead tangent"
+        );
+        assert!(
+            (b[v].coords - want_b).norm() < 1e-12,
+            "vertex {v}: trail tangent"
+        );
+    }
+    let cube = subdyn::examples::cube();
+    let h = default_refiner(&cube).refine_uniform(0).unwrap();
+    let (t1, t2) = limit_tangent_stencils(&h, 0).unwrap();
+    let (a, b) = (
+        t1.apply(&cube.positions).unwrap(),
+        t2.apply(&cube.positions).unwrap(),
+    );
+    let n = a[0].coords.cross(&b[0].coords).normalize();
+    let diagonal = Vector3::new(1.0, 1.0, 1.0).normalize();
+    assert!(
+        n.dot(&diagonal).abs() > 1.0 - 1e-12,
+        "cube corner normal {n:?}"
+    );
+    assert!(a[0].coords.norm() > 0.1 && b[0].coords.norm() > 0.1);
+}

@@ -41,3 +41,52 @@ pub fn limit_stencil(h: &Hierarchy, level: usize) -> Result<StencilTable> {
     });
     rows.compose(&h.stencil_to_level(level)?)
 }
+
+/// Limit tangents of the vertices of level `level`, as two tables of weights
+/// over the level-0 control points: row `v` of the first is the derivative of
+/// the limit surface at vertex `v` along the leading edge of `v`'s first ring
+/// face (its first face counter-clockwise, starting at a boundary edge on a
+/// boundary), the second along that face's trailing edge at `v`; both per unit
+/// of that face's parameter (for an n-gon, of its quad sub-face). At a regular
+/// vertex these are the exact derivatives of the bicubic patch; at an
+/// extraordinary vertex they follow the corner convention of
+/// [`LimitEvaluator`](super::LimitEvaluator) (they span the tangent plane).
+/// Rows of isolated vertices are empty.
+pub fn limit_tangent_stencils(h: &Hierarchy, level: usize) -> Result<(StencilTable, StencilTable)> {
+    let (lv, sh) = (h.level(level), &h.sharpness[level]);
+    let tangent = |which: usize| {
+        StencilTable::from_row_fn(lv.num_vertices, lv.num_vertices, |v, b| {
+            let ring = lv.vertex_ring(v);
+            let Some(&f) = ring.faces.first() else { return };
+            let f = f as usize;
+            let fv = lv.face_vertices(f);
+            let i = fv.iter().position(|&x| x as usize == v).unwrap_or(0);
+            let (u, w, dirs) = if fv.len() == 4 {
+                let c = CORNERS[i];
+                let lead = [
+                    CORNERS[(i + 1) % 4][0] - c[0],
+                    CORNERS[(i + 1) % 4][1] - c[1],
+                ];
+                let trail = [
+                    CORNERS[(i + 3) % 4][0] - c[0],
+                    CORNERS[(i + 3) % 4][1] - c[1],
+                ];
+                (c[0], c[1], [lead, trail])
+            } else {
+                // Sub-face i: s = 2 (u − tu) runs along the leading edge, t along the trailing one.
+                let d = (fv.len() as f64).sqrt().ceil() as usize;
+                ((i % d) as f64, (i / d) as f64, [[0.5, 0.0], [0.0, 0.5]])
+            };
+            let s = evaluate_face(lv, sh, f, u, w);
+            let dir = dirs[which];
+            for (k, &c) in s.cols.iter().enumerate() {
+                let x = dir[0] * s.weights[1][k] + dir[1] * s.weights[2][k];
+                if x != 0.0 {
+                    b.add(c, x);
+                }
+            }
+        })
+    };
+    let to_zero = h.stencil_to_level(level)?;
+    Ok((tangent(0).compose(&to_zero)?, tangent(1).compose(&to_zero)?))
+}
