@@ -51,5 +51,18 @@ fn main() -> subdyn::Result<()> {
         built.as_secs_f64(),
         queried.as_secs_f64()
     );
+    // Fitting moves the control points every step: only positions are redone.
+    let mut engine = engine;
+    let moved: Vec<Point3> = cage
+        .positions
+        .iter()
+        .map(|p| p + 0.1 * offset * p.coords)
+        .collect();
+    let t = Instant::now();
+    engine.set_positions(&moved)?;
+    println!(
+        "set_positions after a small move: {:.3} s",
+        t.elapsed().as_secs_f64()
+    );
     Ok(())
 }

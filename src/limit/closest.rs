@@ -97,15 +97,9 @@ impl ClosestPointEngine {
         if refiner.level.num_faces() == 0 {
             return Err(Error::Input("the control mesh has no faces".into()));
         }
-        let mut engine = ClosestPointEngine {
-            table: PatchTable::new(refiner, positions, params.level)?,
-            seeds: Vec::new(),
-            tree: ImmutableKdTree::new_from_slice(&[[0.0; 3]]),
-            params: params.clone(),
-            scale: bbox_diagonal(positions).max(Real::MIN_POSITIVE),
-        };
         let n = params.seeds_per_side;
-        let seeds: Vec<(u32, [Real; 2])> = (0..engine.table.num_patches() as u32)
+        let table = PatchTable::new(refiner, positions, params.level)?;
+        let seeds: Vec<(u32, [Real; 2])> = (0..table.num_patches() as u32)
             .flat_map(|f| {
                 (0..n * n).map(move |i| {
                     let s = ((i % n) as Real + 0.5) / n as Real;
@@ -114,18 +108,38 @@ impl ClosestPointEngine {
                 })
             })
             .collect();
-        let pts: Vec<[Real; 3]> = seeds
+        let mut engine = ClosestPointEngine {
+            table,
+            seeds,
+            tree: ImmutableKdTree::new_from_slice(&[[0.0; 3]]),
+            params: params.clone(),
+            scale: 0.0,
+        };
+        engine.rebuild_tree()?;
+        Ok(engine)
+    }
+
+    /// Moves the control points (same topology), keeping everything that
+    /// depends on topology alone; cheaper than [`new`](Self::new).
+    pub fn set_positions(&mut self, positions: &[Point3]) -> Result<()> {
+        self.table.set_positions(positions)?;
+        self.rebuild_tree()
+    }
+
+    /// Re-evaluates the seeds and rebuilds their k-d tree.
+    fn rebuild_tree(&mut self) -> Result<()> {
+        let pts: Vec<[Real; 3]> = self
+            .seeds
             .par_iter()
             .map(|&(f, st)| {
-                engine
-                    .table
+                self.table
                     .eval(f as usize, st)
                     .map(|e| [e.p.x, e.p.y, e.p.z])
             })
             .collect::<Result<_>>()?;
-        engine.tree = ImmutableKdTree::new_from_slice(&pts);
-        engine.seeds = seeds;
-        Ok(engine)
+        self.tree = ImmutableKdTree::new_from_slice(&pts);
+        self.scale = bbox_diagonal(self.table.positions()).max(Real::MIN_POSITIVE);
+        Ok(())
     }
 
     /// The closest limit-surface point to `q`.

@@ -145,14 +145,15 @@ impl LocalPatch {
     }
 
     /// The 16 B-spline control points of regular local face `f`, as dense
-    /// rows over `cols`.
-    pub(crate) fn grid_rows(&self, f: u32) -> [Vec<Real>; 16] {
+    /// rows over `cols`, one after the other (`16 × cols.len()`).
+    pub(crate) fn grid_rows(&self, f: u32) -> Vec<Real> {
         let grid = patch_grid(&self.level, &self.sharp, f as usize);
-        std::array::from_fn(|i| {
-            let mut out = vec![0.0; self.ncols()];
-            self.accumulate(&grid[i], 1.0, &mut out);
-            out
-        })
+        let nc = self.ncols();
+        let mut out = vec![0.0; 16 * nc];
+        for (b, row) in grid.iter().zip(out.chunks_mut(nc.max(1))) {
+            self.accumulate(b, 1.0, row);
+        }
+        out
     }
 
     /// Adds `scale ×` the row of local vertex-combination `b` into `out`.

@@ -9,6 +9,11 @@
 //! [`LimitEvaluator`] (OpenSubdiv's feature-adaptive patch tables rest on the
 //! same observation, Nießner et al. 2012). Evaluation is then a 16-point
 //! product almost everywhere.
+//!
+//! Everything but the positions is built once: the patches' control points
+//! are one stencil table over the level-`L` vertices, and the quadtree leaves
+//! keep weights, not points. [`PatchTable::set_positions`] moves the control
+//! mesh (as fitting does every step) with two sparse products.
 
 use std::ops::{Add, Mul};
 use std::sync::OnceLock;
@@ -17,6 +22,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::math::{Point3, Real, Vector3};
+use crate::stencil::{RowBuilder, StencilTable};
 use crate::subdivision::{Hierarchy, Refiner};
 use crate::topology::{Level, Sharpness};
 
@@ -28,25 +34,34 @@ use super::{LimitEvaluator, LimitPoint, Sample};
 /// Levels of local subdivision below `L` for faces at irregular vertices.
 pub const TREE_DEPTH: usize = 6;
 
-/// A level-`L` face: its limit patch and its place in its base face.
+/// A level-`L` face: its place in its base face and, near an irregular
+/// vertex, its quadtree.
 struct Patch {
-    /// Control points of the bicubic patch, or `None` near an irregular vertex.
-    grid: Option<[Point3; 16]>,
+    /// True when the face is a regular bicubic patch (rows in `grid_table`).
+    regular: bool,
     /// Regular leaves of the local subdivision of an irregular face (lazy).
-    tree: OnceLock<Vec<Leaf>>,
+    tree: OnceLock<Tree>,
     base: u32,
     /// Base `(u, v) = origin + axes · (s, t)`.
     origin: [Real; 2],
     axes: [[Real; 2]; 2],
 }
 
+/// The quadtree of an irregular face: its leaves' control points are dense
+/// rows of weights over the level-`L` vertices `cols` (the face's 1-ring).
+struct Tree {
+    cols: Vec<u32>,
+    leaves: Vec<Leaf>,
+}
+
 /// A cell of an irregular face's quadtree: leaf `(s', t') = J (s, t) + c`
-/// in the face's `(s, t)`, with its bicubic control points (`None` for the
-/// innermost cell at an irregular vertex, evaluated exactly).
+/// in the face's `(s, t)`, with its 16 bicubic control points as rows over
+/// the tree's `cols`, one after the other (`None` for the innermost cell at an
+/// irregular vertex, evaluated exactly).
 struct Leaf {
     jac: [[Real; 2]; 2],
     off: [Real; 2],
-    grid: Option<[Point3; 16]>,
+    grid: Option<Vec<Real>>,
 }
 
 /// Position and derivatives `∂s, ∂t, ∂ss, ∂st, ∂tt` in a patch's own `(s, t)`.
@@ -61,10 +76,16 @@ pub struct PatchPoint {
 /// The limit surface of one control mesh (fixed positions) as level-`L` patches.
 pub struct PatchTable {
     evaluator: LimitEvaluator,
-    positions: Vec<Point3>,
     level: Level,
     sharp: Sharpness,
+    /// Level-0 → level-`L` refinement, `P_L = S P_0`.
+    to_level: StencilTable,
+    /// Control points of the regular patches: rows `16 f .. 16 f + 16` over
+    /// level-`L` vertices (empty rows for irregular faces).
+    grid_table: StencilTable,
+    positions: Vec<Point3>,
     level_positions: Vec<Point3>,
+    grid_points: Vec<Point3>,
     /// Face offsets of levels `0..L`, to locate a base `(face, u, v)`.
     offsets: Vec<Vec<u32>>,
     patches: Vec<Patch>,
@@ -86,48 +107,73 @@ impl PatchTable {
             )));
         }
         let h = refiner.refine_uniform(level)?;
-        let mut pl = h.refine_positions(positions)?;
-        let lp = pl.pop().expect("levels exist");
         let fine = h.finest();
         let sharp = h.sharpness.last().expect("levels exist");
         let maps = param_maps(&h);
-        let patches = (0..fine.num_faces())
+        let regular: Vec<bool> = (0..fine.num_faces())
             .into_par_iter()
             .map(|f| {
-                let regular = fine.face_vertices(f).iter().all(|&c| {
+                fine.face_vertices(f).iter().all(|&c| {
                     corner_kind(fine, sharp, c as usize, f as u32) != CornerKind::Irregular
-                });
-                let grid = regular.then(|| {
-                    patch_grid(fine, sharp, f).map(|b| {
-                        Point3::from(
-                            b.entries()
-                                .map(|(c, w)| w * lp[c as usize].coords)
-                                .sum::<Vector3>(),
-                        )
-                    })
-                });
-                let (base, origin, axes) = maps[f];
-                Patch {
-                    grid,
-                    tree: OnceLock::new(),
-                    base,
-                    origin,
-                    axes,
-                }
+                })
             })
             .collect();
-        Ok(PatchTable {
+        let grids: Vec<Option<[RowBuilder; 16]>> = (0..fine.num_faces())
+            .into_par_iter()
+            .map(|f| regular[f].then(|| patch_grid(fine, sharp, f)))
+            .collect();
+        let mut grid_table = StencilTable::with_capacity(fine.num_vertices, 16 * grids.len(), 0);
+        for g in &grids {
+            for k in 0..16 {
+                match g {
+                    Some(rows) => grid_table.push_row(rows[k].entries()),
+                    None => grid_table.push_row(std::iter::empty()),
+                }
+            }
+        }
+        let patches = maps
+            .into_iter()
+            .zip(&regular)
+            .map(|((base, origin, axes), &regular)| Patch {
+                regular,
+                tree: OnceLock::new(),
+                base,
+                origin,
+                axes,
+            })
+            .collect();
+        let mut table = PatchTable {
             evaluator: LimitEvaluator::new(refiner),
-            positions: positions.to_vec(),
             level: fine.clone(),
             sharp: sharp.clone(),
-            level_positions: lp,
+            to_level: h.stencil_to_level(level)?,
+            grid_table,
+            positions: Vec::new(),
+            level_positions: Vec::new(),
+            grid_points: Vec::new(),
             offsets: h.levels[..level]
                 .iter()
                 .map(|l| l.face_offsets.clone())
                 .collect(),
             patches,
-        })
+        };
+        table.set_positions(positions)?;
+        Ok(table)
+    }
+
+    /// Moves the control points (same topology): two sparse products; the
+    /// quadtrees built so far are kept.
+    pub fn set_positions(&mut self, positions: &[Point3]) -> Result<()> {
+        crate::mesh::check_finite(positions)?;
+        self.level_positions = self.to_level.apply(positions)?;
+        self.grid_points = self.grid_table.apply(&self.level_positions)?;
+        self.positions = positions.to_vec();
+        Ok(())
+    }
+
+    /// The control points.
+    pub fn positions(&self) -> &[Point3] {
+        &self.positions
     }
 
     /// Number of patches (faces of level `L`).
@@ -143,10 +189,14 @@ impl PatchTable {
     /// Evaluates patch `f` at `(s, t) ∈ [0, 1]²`.
     pub fn eval(&self, f: usize, st: [Real; 2]) -> Result<PatchPoint> {
         let patch = &self.patches[f];
-        if let Some(grid) = &patch.grid {
+        if patch.regular {
+            let grid: &[Point3; 16] = self.grid_points[16 * f..16 * f + 16]
+                .try_into()
+                .expect("16 control points per patch");
             return Ok(bicubic(grid, st));
         }
-        let leaves = patch.tree.get_or_init(|| self.leaves(f));
+        let tree = patch.tree.get_or_init(|| self.tree(f));
+        let cols = &tree.cols;
         let local = |l: &Leaf| {
             [
                 l.jac[0][0] * st[0] + l.jac[0][1] * st[1] + l.off[0],
@@ -154,10 +204,20 @@ impl PatchTable {
             ]
         };
         let inside = |x: [Real; 2]| x.iter().all(|c| (-1e-12..=1.0 + 1e-12).contains(c));
-        for leaf in leaves {
+        for leaf in &tree.leaves {
             let x = local(leaf);
-            if let (Some(grid), true) = (&leaf.grid, inside(x)) {
-                let e = bicubic(grid, [x[0].clamp(0.0, 1.0), x[1].clamp(0.0, 1.0)]);
+            if let (Some(rows), true) = (&leaf.grid, inside(x)) {
+                let nc = cols.len().max(1);
+                let grid: [Point3; 16] = std::array::from_fn(|k| {
+                    Point3::from(
+                        rows[k * nc..(k + 1) * nc]
+                            .iter()
+                            .zip(cols)
+                            .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
+                            .sum::<Vector3>(),
+                    )
+                });
+                let e = bicubic(&grid, [x[0].clamp(0.0, 1.0), x[1].clamp(0.0, 1.0)]);
                 return Ok(PatchPoint {
                     p: e.p,
                     d: chain(e.d, leaf.jac),
@@ -238,25 +298,12 @@ impl PatchTable {
         })
     }
 
-    /// Quadtree leaves of irregular level-`L` face `f` (see module docs).
-    fn leaves(&self, f: usize) -> Vec<Leaf> {
-        let positions = |rows: [Vec<Real>; 16], cols: &[u32]| -> [Point3; 16] {
-            rows.map(|r| {
-                Point3::from(
-                    r.iter()
-                        .zip(cols)
-                        .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
-                        .sum::<Vector3>(),
-                )
-            })
-        };
+    /// The quadtree of irregular level-`L` face `f` (see module docs).
+    fn tree(&self, f: usize) -> Tree {
         let mut leaves = Vec::new();
-        let mut stack = vec![(
-            LocalPatch::around(&self.level, &self.sharp, f),
-            [[1.0, 0.0], [0.0, 1.0]],
-            [0.0, 0.0],
-            0,
-        )];
+        let root = LocalPatch::around(&self.level, &self.sharp, f);
+        let cols = root.cols.clone();
+        let mut stack = vec![(root, [[1.0, 0.0], [0.0, 1.0]], [0.0, 0.0], 0)];
         while let Some((patch, jac, off, depth)) = stack.pop() {
             if depth == TREE_DEPTH {
                 leaves.push(Leaf {
@@ -273,18 +320,17 @@ impl PatchTable {
                 let co = mat_vec(m, [off[0] - o[0], off[1] - o[1]]);
                 let cf = patch.child_face(k);
                 if refined.is_regular(cf) {
-                    let grid = positions(refined.grid_rows(cf), &refined.cols);
                     leaves.push(Leaf {
                         jac: cj,
                         off: co,
-                        grid: Some(grid),
+                        grid: Some(refined.grid_rows(cf)),
                     });
                 } else {
                     stack.push((refined.extract(cf), cj, co, depth + 1));
                 }
             }
         }
-        leaves
+        Tree { cols, leaves }
     }
 }
 

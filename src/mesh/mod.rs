@@ -5,3 +5,4 @@ mod poly_mesh;
 
 pub use point_cloud::PointCloud;
 pub use poly_mesh::PolyMesh;
+pub(crate) use poly_mesh::check_finite;
