@@ -949,3 +949,51 @@ fn vertex_limit_tangents_span_the_tangent_plane() {
     );
     assert!(a[0].coords.norm() > 0.1 && b[0].coords.norm() > 0.1);
 }
+
+/// Moving the control points of an engine gives the same answers as building
+/// a new engine at the new positions (fitting relies on this).
+#[test]
+fn closest_point_engine_set_positions_equals_a_fresh_engine() {
+    let mesh = reference_mesh("fan5_open");
+    let r = default_refiner(&mesh);
+    let moved: Vec<Point3> = mesh
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| p + Vector3::new(0.01 * i as f64, -0.02, 0.03 * (i % 3) as f64))
+        .collect();
+    let params = ClosestPointParams::default();
+    let mut engine = ClosestPointEngine::new(&r, &mesh.positions, &params).unwrap();
+    let queries: Vec<Point3> = (0..40)
+        .map(|i| {
+            let t = i as f64 / 40.0;
+            Point3::new(1.5 * (6.0 * t).cos(), 1.5 * (6.0 * t).sin(), 0.5 - t)
+        })
+        .collect();
+    // Warm the quadtrees at the old positions first, then move.
+    engine.closest_points(&queries).unwrap();
+    engine.set_positions(&moved).unwrap();
+    let fresh = ClosestPointEngine::new(&r, &moved, &params).unwrap();
+    for q in &queries {
+        let (a, b) = (
+            engine.closest_point(*q).unwrap(),
+            fresh.closest_point(*q).unwrap(),
+        );
+        assert!(
+            (a.distance - b.distance).abs() < 1e-12,
+            "{q}: {} vs {}",
+            a.distance,
+            b.distance
+        );
+        assert!(
+            (a.point - b.point).norm() < 1e-9,
+            "{q}: {} vs {}",
+            a.point,
+            b.point
+        );
+    }
+    assert!(
+        engine.set_positions(&moved[1..]).is_err(),
+        "wrong count must be rejected"
+    );
+}
