@@ -676,3 +676,41 @@ fn bench_subdivide_prints_json_last_line() {
     assert!(out.contains("stencil apply"), "human-readable table: {out}");
     assert!(files(dir.path()).is_empty());
 }
+
+#[test]
+fn bench_closest_is_exact_and_prints_json_last_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = ok(&subdyn(
+        dir.path(),
+        &[
+            "bench",
+            "closest",
+            "--queries",
+            "300",
+            "--baseline-tess",
+            "2",
+            "--quiet",
+        ],
+    ));
+    let last = out.lines().last().expect("some output");
+    let json: Value = serde_json::from_str(last).expect("the last line is JSON");
+    for key in ["build_s", "query_s", "set_positions_s", "baseline_query_s"] {
+        assert!(
+            json[key].as_f64().is_some_and(|s| s >= 0.0),
+            "{key} in {last}"
+        );
+    }
+    assert_eq!(json["queries"], 300);
+    // The engine never reports a distance beyond the known bound; a coarse
+    // tessellation's nearest vertex does.
+    assert!(
+        json["max_excess_engine"].as_f64().unwrap() < 1e-12,
+        "{last}"
+    );
+    assert!(
+        json["max_excess_baseline"].as_f64().unwrap() > 1e-6,
+        "{last}"
+    );
+    let bad = subdyn(dir.path(), &["bench", "closest", "--queries", "0"]);
+    assert_eq!(bad.status.code(), Some(1));
+}

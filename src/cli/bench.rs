@@ -35,6 +35,9 @@ pub enum BenchCommand {
     /// Uniform Catmull-Clark refinement of an N×N quad torus, stage by stage;
     /// the last stdout line is one JSON object with the seconds.
     Subdivide(BenchSubdivideArgs),
+    /// Exact closest points on the limit surface against a tessellation +
+    /// k-d tree baseline; the last stdout line is one JSON object.
+    Closest(super::bench_closest::BenchClosestArgs),
 }
 
 /// Arguments of `subdyn bench subdivide`.
@@ -61,6 +64,7 @@ pub struct BenchSubdivideArgs {
 pub fn run(cmd: &BenchCommand) -> anyhow::Result<()> {
     match cmd {
         BenchCommand::Subdivide(args) => bench_subdivide(args),
+        BenchCommand::Closest(args) => super::bench_closest::bench_closest(args),
     }
 }
 

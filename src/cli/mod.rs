@@ -2,6 +2,7 @@
 
 mod app;
 mod bench;
+mod bench_closest;
 mod common;
 mod info;
 mod limit;
