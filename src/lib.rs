@@ -18,7 +18,9 @@
 //! Modules: [`math`] (scalar and point types), [`error`], [`mesh`] (polygon
 //! meshes, point clouds), [`io`] (OBJ, PLY, OFF, XYZ), [`topology`] (edges,
 //! adjacency, tags), [`subdivision`] (Catmull-Clark refinement), [`stencil`]
-//! (CSR stencil tables), [`limit`] (limit masks, exact evaluation, closest point).
+//! (CSR stencil tables), [`limit`] (limit masks, exact evaluation, closest point),
+//! [`metrics`] (point-to-mesh distances, Chamfer, Hausdorff), [`render`]
+//! (software rasteriser for pictures).
 
 #![warn(missing_docs)]
 
@@ -28,6 +30,8 @@ pub mod io;
 pub mod limit;
 pub mod math;
 pub mod mesh;
+pub mod metrics;
+pub mod render;
 pub mod stencil;
 pub mod subdivision;
 pub mod topology;

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use super::{bench, common, info, limit, subdivide};
+use super::{bench, common, compare, info, limit, render, subdivide};
 
 /// subdyn: Catmull-Clark subdivision surfaces — refinement as stencil tables,
 /// exact limit evaluation, mesh inspection and benchmarks.
@@ -30,6 +30,10 @@ enum Command {
     Limit(limit::LimitArgs),
     /// Print counts, boundaries, components, genus, valences and the bounding box of a mesh or point file.
     Info(info::InfoArgs),
+    /// Distances from A to B (B the reference): mean, RMS, 95th percentile, Hausdorff, Chamfer.
+    Compare(compare::CompareArgs),
+    /// Draw a mesh and/or point cloud to a PNG (software rasteriser).
+    Render(render::RenderArgs),
     /// Benchmarks (timings as a table, then one JSON line).
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -44,6 +48,8 @@ pub fn run() -> ExitCode {
         Command::Subdivide(args) => subdivide::run(&args),
         Command::Limit(args) => limit::run(&args),
         Command::Info(args) => info::run(&args),
+        Command::Compare(args) => compare::run(&args),
+        Command::Render(args) => render::run(&args),
         Command::Bench(cmd) => bench::run(&cmd),
     };
     match result {

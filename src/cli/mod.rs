@@ -4,11 +4,13 @@ mod app;
 mod bench;
 mod bench_closest;
 mod common;
+mod compare;
 mod info;
 mod limit;
 mod mesh_stats;
 mod options;
 mod progress;
+mod render;
 mod subdivide;
 
 pub use app::run;

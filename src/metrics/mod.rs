@@ -1,0 +1,2 @@
+//! Distances between geometry: point-to-triangle-mesh distances with a BVH,
+//! one-sided and symmetric statistics, Chamfer and Hausdorff distances.
