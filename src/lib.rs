@@ -24,6 +24,7 @@
 
 #![warn(missing_docs)]
 
+pub mod dynamics;
 pub mod error;
 pub mod examples;
 pub mod io;

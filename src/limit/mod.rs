@@ -15,6 +15,7 @@ pub use closest::{ClosestPoint, ClosestPointEngine, ClosestPointParams};
 pub use evaluator::{LimitEvaluator, LimitPoint, LimitStencils, Sample};
 pub use limit_stencil::{limit_stencil, limit_tangent_stencils};
 pub use patch::SampleStencil;
+pub(crate) use patch_table::chain as chain_rule;
 pub use patch_table::{PatchPoint, PatchTable, TREE_DEPTH};
 pub use tessellate::tessellate;
 pub use vertex_masks::CornerKind;

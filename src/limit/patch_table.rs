@@ -27,7 +27,10 @@ use crate::subdivision::{Hierarchy, Refiner};
 use crate::topology::{Level, Sharpness};
 
 use super::bspline::patch_weights;
-use super::patch::{CORNERS, LocalPatch, child_frame, mat_mul, mat_vec, patch_grid, quadrant};
+use super::patch::{
+    CORNERS, LocalPatch, SampleStencil, child_frame, evaluate_face, mat_mul, mat_vec, patch_grid,
+    quadrant,
+};
 use super::vertex_masks::{CornerKind, corner_kind};
 use super::{LimitEvaluator, LimitPoint, Sample};
 
@@ -234,6 +237,87 @@ impl PatchTable {
         })
     }
 
+    /// Weights of the limit position and its `(s, t)` derivatives at
+    /// `(s, t)` of patch `f` over the level-`L` vertices (compose with
+    /// [`to_level`](Self::to_level) for weights over the control points,
+    /// or transform a matrix assembled over level `L` as `Sᵀ M S`).
+    pub fn stencil(&self, f: usize, st: [Real; 2]) -> SampleStencil {
+        let patch = &self.patches[f];
+        let w = patch_weights(st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0));
+        if patch.regular {
+            let mut b: [RowBuilder; 6] = Default::default();
+            for i in 0..16 {
+                let (cols, ws) = self.grid_table.row(16 * f + i);
+                for q in 0..6 {
+                    if w[q][i] != 0.0 {
+                        for (&c, &x) in cols.iter().zip(ws) {
+                            b[q].add(c, w[q][i] * x);
+                        }
+                    }
+                }
+            }
+            return builders_to_stencil(&b);
+        }
+        let tree = patch.tree.get_or_init(|| self.tree(f));
+        let nc = tree.cols.len();
+        for leaf in &tree.leaves {
+            let x = [
+                leaf.jac[0][0] * st[0] + leaf.jac[0][1] * st[1] + leaf.off[0],
+                leaf.jac[1][0] * st[0] + leaf.jac[1][1] * st[1] + leaf.off[1],
+            ];
+            let inside = x.iter().all(|c| (-1e-12..=1.0 + 1e-12).contains(c));
+            if let (Some(rows), true) = (&leaf.grid, inside) {
+                let w = patch_weights(x[0].clamp(0.0, 1.0), x[1].clamp(0.0, 1.0));
+                let local: [Vec<Real>; 6] = std::array::from_fn(|q| {
+                    let mut out = vec![0.0; nc];
+                    for i in 0..16 {
+                        for (o, &r) in out.iter_mut().zip(&rows[i * nc..(i + 1) * nc]) {
+                            *o += w[q][i] * r;
+                        }
+                    }
+                    out
+                });
+                let mut weights: [Vec<Real>; 6] = std::array::from_fn(|_| vec![0.0; nc]);
+                for k in 0..nc {
+                    weights[0][k] = local[0][k];
+                    let d = chain([1, 2, 3, 4, 5].map(|q| local[q][k]), leaf.jac);
+                    for q in 0..5 {
+                        weights[q + 1][k] = d[q];
+                    }
+                }
+                return SampleStencil {
+                    cols: tree.cols.clone(),
+                    weights,
+                };
+            }
+        }
+        evaluate_face(&self.level, &self.sharp, f, st[0], st[1])
+    }
+
+    /// The refinement `P_L = S P_0` from the control points to level `L`.
+    pub fn to_level(&self) -> &StencilTable {
+        &self.to_level
+    }
+
+    /// The affine map of patch `f`'s `(s, t)` into its base face's `(u, v)`:
+    /// `(u, v) = origin + axes · (s, t)`.
+    pub fn patch_frame(&self, f: usize) -> ([Real; 2], [[Real; 2]; 2]) {
+        (self.patches[f].origin, self.patches[f].axes)
+    }
+
+    /// The cells on which patch `f` is one polynomial piece: `(J, c)` with
+    /// cell coordinates `J (s, t) + c ∈ [0, 1]²` — the whole patch for a
+    /// regular face, the quadtree leaves (and the innermost cells) otherwise.
+    /// Quadrature on each cell is exact for polynomial integrands.
+    pub fn cells(&self, f: usize) -> Vec<([[Real; 2]; 2], [Real; 2])> {
+        let patch = &self.patches[f];
+        if patch.regular {
+            return vec![([[1.0, 0.0], [0.0, 1.0]], [0.0, 0.0])];
+        }
+        let tree = patch.tree.get_or_init(|| self.tree(f));
+        tree.leaves.iter().map(|l| (l.jac, l.off)).collect()
+    }
+
     /// The base-face sample of patch `f` at `(s, t)`.
     pub fn sample(&self, f: usize, st: [Real; 2]) -> Sample {
         let p = &self.patches[f];
@@ -332,6 +416,26 @@ impl PatchTable {
         }
         Tree { cols, leaves }
     }
+}
+
+/// Six row builders as one [`SampleStencil`] over the union of their columns.
+fn builders_to_stencil(b: &[RowBuilder; 6]) -> SampleStencil {
+    let mut cols: Vec<u32> = Vec::new();
+    for (c, _) in b.iter().flat_map(|r| r.entries()) {
+        if !cols.contains(&c) {
+            cols.push(c);
+        }
+    }
+    let weights = std::array::from_fn(|q| {
+        let mut w = vec![0.0; cols.len()];
+        for (c, x) in b[q].entries() {
+            if let Some(k) = cols.iter().position(|&y| y == c) {
+                w[k] += x;
+            }
+        }
+        w
+    });
+    SampleStencil { cols, weights }
 }
 
 /// Bicubic B-spline patch value and derivatives at `(s, t)`.

@@ -36,6 +36,16 @@ impl StencilTable {
         }
     }
 
+    /// The `rows × cols` zero matrix (every row empty).
+    pub fn zeros(rows: usize, cols: usize) -> Self {
+        StencilTable {
+            num_cols: cols,
+            offsets: vec![0; rows + 1],
+            indices: Vec::new(),
+            weights: Vec::new(),
+        }
+    }
+
     /// An empty table with `num_cols` columns, ready for [`push_row`](Self::push_row).
     pub fn with_capacity(num_cols: usize, rows: usize, entries: usize) -> Self {
         let mut offsets = Vec::with_capacity(rows + 1);
@@ -363,5 +373,100 @@ impl StencilTable {
             out.weights.extend_from_slice(&wts);
         }
         out
+    }
+}
+
+impl StencilTable {
+    /// Every row `r` multiplied by `s[r]`.
+    pub fn scale_rows(&self, s: &[Real]) -> Result<StencilTable> {
+        if s.len() != self.num_rows() {
+            return Err(Error::Input(format!(
+                "{} row scales for a table of {} rows",
+                s.len(),
+                self.num_rows()
+            )));
+        }
+        let mut t = self.clone();
+        for r in 0..t.num_rows() {
+            for w in &mut t.weights[t.offsets[r]..t.offsets[r + 1]] {
+                *w *= s[r];
+            }
+        }
+        Ok(t)
+    }
+
+    /// The tables stacked vertically (same number of columns).
+    pub fn stack(tables: &[&StencilTable]) -> Result<StencilTable> {
+        let cols = tables.first().map_or(0, |t| t.num_cols);
+        if let Some(t) = tables.iter().find(|t| t.num_cols != cols) {
+            return Err(Error::Input(format!(
+                "cannot stack tables of {} and {} columns",
+                cols, t.num_cols
+            )));
+        }
+        let rows = tables.iter().map(|t| t.num_rows()).sum();
+        let entries = tables.iter().map(|t| t.num_entries()).sum();
+        let mut out = StencilTable::with_capacity(cols, rows, entries);
+        for t in tables {
+            for r in 0..t.num_rows() {
+                let (c, w) = t.row(r);
+                out.indices.extend_from_slice(c);
+                out.weights.extend_from_slice(w);
+                out.offsets.push(out.indices.len());
+            }
+        }
+        Ok(out)
+    }
+
+    /// The Gram matrix `selfᵀ · self` (`num_cols × num_cols`, symmetric):
+    /// the assembly of `Σ_r a_rᵀ a_r` over the rows.
+    pub fn gram(&self) -> StencilTable {
+        self.transpose()
+            .compose(self)
+            .expect("a table composes with its own transpose")
+    }
+
+    /// The diagonal of a square table.
+    pub fn diagonal(&self) -> Vec<Real> {
+        (0..self.num_rows())
+            .map(|r| {
+                let (c, w) = self.row(r);
+                c.iter()
+                    .zip(w)
+                    .filter(|(c, _)| **c as usize == r)
+                    .map(|(_, w)| w)
+                    .sum()
+            })
+            .collect()
+    }
+
+    /// `a · self + b · other` for tables of the same shape.
+    pub fn linear_combination(
+        &self,
+        a: Real,
+        other: &StencilTable,
+        b: Real,
+    ) -> Result<StencilTable> {
+        if self.num_cols != other.num_cols || self.num_rows() != other.num_rows() {
+            return Err(Error::Input(format!(
+                "cannot add a {}×{} table to a {}×{} table",
+                other.num_rows(),
+                other.num_cols,
+                self.num_rows(),
+                self.num_cols
+            )));
+        }
+        let mut out = StencilTable::with_capacity(self.num_cols, self.num_rows(), 0);
+        for r in 0..self.num_rows() {
+            let (c1, w1) = self.row(r);
+            let (c2, w2) = other.row(r);
+            out.push_row(
+                c1.iter()
+                    .zip(w1)
+                    .map(|(&c, &w)| (c, a * w))
+                    .chain(c2.iter().zip(w2).map(|(&c, &w)| (c, b * w))),
+            );
+        }
+        Ok(out)
     }
 }

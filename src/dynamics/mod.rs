@@ -1,0 +1,12 @@
+//! Dynamic Catmull-Clark surfaces (Qin, Mandal, Vemuri 1998): quadrature over
+//! the limit surface, mass / damping / thin-plate-under-tension stiffness
+//! matrices assembled over the control points, and a preconditioned conjugate
+//! gradient solver.
+
+mod matrices;
+mod pcg;
+mod quadrature;
+
+pub use matrices::{MaterialParams, damping_matrix, mass_matrix, stiffness_matrix};
+pub use pcg::{PcgParams, PcgReport, pcg};
+pub use quadrature::{Quadrature, gauss_legendre, quadrature};

@@ -1,0 +1,313 @@
+//! Physics of dynamic Catmull-Clark surfaces: quadrature, mass, damping,
+//! stiffness, conjugate gradients.
+
+mod common;
+
+use common::{default_refiner, reference_mesh};
+use subdyn::dynamics::{
+    MaterialParams, PcgParams, gauss_legendre, mass_matrix, pcg, quadrature, stiffness_matrix,
+};
+use subdyn::limit::{LimitEvaluator, PatchTable, tessellate};
+use subdyn::math::{Point3, Real};
+use subdyn::mesh::PolyMesh;
+use subdyn::stencil::StencilTable;
+
+fn lcg(seed: &mut u64) -> Real {
+    *seed = seed
+        .wrapping_mul(6_364_136_223_846_793_005)
+        .wrapping_add(1_442_695_040_888_963_407);
+    (*seed >> 11) as Real / (1u64 << 53) as Real
+}
+
+/// Dense copy of a square table.
+fn dense(a: &StencilTable) -> Vec<Vec<Real>> {
+    let n = a.num_rows();
+    let mut m = vec![vec![0.0; a.num_cols]; n];
+    for (r, row) in m.iter_mut().enumerate() {
+        let (c, w) = a.row(r);
+        for (&c, &w) in c.iter().zip(w) {
+            row[c as usize] += w;
+        }
+    }
+    m
+}
+
+fn quad_form(a: &StencilTable, x: &[Real]) -> Real {
+    let ax = a.apply_scalar(x).unwrap();
+    ax.iter().zip(x).map(|(a, b)| a * b).sum()
+}
+
+fn assert_symmetric(a: &StencilTable, what: &str) {
+    let m = dense(a);
+    let scale = m.iter().flatten().fold(0.0f64, |s, x| s.max(x.abs()));
+    for i in 0..m.len() {
+        for j in 0..i {
+            assert!(
+                (m[i][j] - m[j][i]).abs() <= 1e-13 * scale,
+                "{what} not symmetric at ({i}, {j})"
+            );
+        }
+    }
+}
+
+/// A flat n × n grid of unit squares in the plane z = 0.
+fn flat_grid(n: usize) -> PolyMesh {
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let positions = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| Point3::new(i as Real, j as Real, 0.0)))
+        .collect();
+    let faces: Vec<Vec<u32>> = (0..n)
+        .flat_map(|j| {
+            (0..n).map(move |i| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
+        })
+        .collect();
+    PolyMesh::from_faces(positions, &faces).unwrap()
+}
+
+#[test]
+fn gauss_legendre_is_exact_to_degree_2n_minus_1() {
+    for n in 1..=10 {
+        let gl = gauss_legendre(n);
+        assert_eq!(gl.len(), n);
+        for k in 0..2 * n {
+            let integral: Real = gl.iter().map(|(x, w)| w * x.powi(k as i32)).sum();
+            assert!(
+                (integral - 1.0 / (k as Real + 1.0)).abs() < 1e-14,
+                "n {n}, x^{k}: {integral}"
+            );
+        }
+    }
+}
+
+#[test]
+fn patch_table_stencils_reproduce_evaluation() {
+    for mesh in [subdyn::examples::cube(), reference_mesh("fan5_open")] {
+        let r = default_refiner(&mesh);
+        let table = PatchTable::new(&r, &mesh.positions, 2).unwrap();
+        let lp = table.to_level().apply(&mesh.positions).unwrap();
+        let mut seed = 7;
+        for _ in 0..300 {
+            let f = (lcg(&mut seed) * table.num_patches() as Real) as usize;
+            let st = [lcg(&mut seed), lcg(&mut seed)];
+            let e = table.eval(f, st).unwrap();
+            let s = table.stencil(f, st);
+            let q: Vec<_> = (0..6)
+                .map(|k| {
+                    s.cols
+                        .iter()
+                        .zip(&s.weights[k])
+                        .map(|(&c, &w)| w * lp[c as usize].coords)
+                        .sum::<subdyn::math::Vector3>()
+                })
+                .collect();
+            assert!(
+                (q[0] - e.p.coords).norm() < 1e-12,
+                "position at patch {f} {st:?}"
+            );
+            for k in 0..5 {
+                assert!(
+                    (q[k + 1] - e.d[k]).norm() < 1e-9 * (1.0 + e.d[k].norm()),
+                    "derivative {k} at patch {f} {st:?}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn mass_matrix_is_spd_and_sums_to_mu_times_area() {
+    let mu = 2.5;
+    // Flat grid: the limit surface is the square [0, n]² exactly.
+    let grid = flat_grid(4);
+    let r = default_refiner(&grid);
+    let table = PatchTable::new(&r, &grid.positions, 2).unwrap();
+    let q = quadrature(&table, 4).unwrap();
+    let lp = table.to_level().apply(&grid.positions).unwrap();
+    let m = mass_matrix(&q, table.to_level(), Some(&lp), mu).unwrap();
+    let total: Real = m.weights.iter().sum();
+    assert!(
+        (total - mu * 16.0).abs() < 1e-10,
+        "flat grid: Σ M = {total}, want {}",
+        mu * 16.0
+    );
+    // Parameter measure: Σ M = μ · (number of faces).
+    let mp = mass_matrix(&q, table.to_level(), None, mu).unwrap();
+    let total: Real = mp.weights.iter().sum();
+    assert!((total - mu * 16.0).abs() < 1e-10);
+
+    // Cube (valence-3 vertices everywhere): against the area of a fine tessellation.
+    let cube = subdyn::examples::cube();
+    let r = default_refiner(&cube);
+    let table = PatchTable::new(&r, &cube.positions, 2).unwrap();
+    let q = quadrature(&table, 4).unwrap();
+    let lp = table.to_level().apply(&cube.positions).unwrap();
+    let m = mass_matrix(&q, table.to_level(), Some(&lp), mu).unwrap();
+    // Tessellation areas converge as O(h²): Richardson-extrapolate two rates.
+    let tess_area = |k: usize| -> Real {
+        let (tess, _) = tessellate(&r, &cube.positions, k).unwrap();
+        tess.faces()
+            .map(|f| {
+                let p: Vec<_> = f.iter().map(|&v| tess.positions[v as usize]).collect();
+                0.5 * ((p[1] - p[0]).cross(&(p[2] - p[0])).norm()
+                    + (p[2] - p[0]).cross(&(p[3] - p[0])).norm())
+            })
+            .sum()
+    };
+    let area = (4.0 * tess_area(64) - tess_area(32)) / 3.0;
+    let total: Real = m.weights.iter().sum();
+    assert!(
+        (total / (mu * area) - 1.0).abs() < 2e-5,
+        "cube: Σ M = {total}, μ·area ≈ {}",
+        mu * area
+    );
+    assert_symmetric(&m, "M");
+    // The cube's own M is only semi-definite: the checkerboard pattern of its
+    // 8 control points (+1 on one tetrahedron, −1 on the other) has a zero
+    // limit surface (limit mask 9/24 − 3·4/24 + 3·1/24 = 0), so it is in the
+    // null space. One level finer the map to the limit surface is injective.
+    let checker: Vec<Real> = (0..8)
+        .map(|i: u32| if i.count_ones() % 2 == 0 { 1.0 } else { -1.0 })
+        .collect();
+    assert!(quad_form(&m, &checker).abs() < 1e-12);
+    for mesh in [
+        grid,
+        reference_mesh("torus_regular"),
+        reference_mesh("fan5_open"),
+    ] {
+        let r = default_refiner(&mesh);
+        let table = PatchTable::new(&r, &mesh.positions, 2).unwrap();
+        let q = quadrature(&table, 4).unwrap();
+        let lp = table.to_level().apply(&mesh.positions).unwrap();
+        let m = mass_matrix(&q, table.to_level(), Some(&lp), mu).unwrap();
+        assert_symmetric(&m, "M");
+        let mut x = vec![Point3::origin(); m.num_rows()];
+        // Positive definite: CG on M converges from any right-hand side.
+        let b: Vec<Point3> = (0..m.num_rows())
+            .map(|i| Point3::new(1.0, i as Real, (i % 3) as Real))
+            .collect();
+        let report = pcg(&m, &b, &mut x, &PcgParams::default()).unwrap();
+        assert!(report.converged, "{report:?}");
+        let mut seed = 3;
+        for _ in 0..20 {
+            let x: Vec<Real> = (0..m.num_rows()).map(|_| lcg(&mut seed) - 0.5).collect();
+            assert!(quad_form(&m, &x) > 0.0, "M must be positive definite");
+        }
+    }
+}
+
+#[test]
+fn stiffness_is_psd_with_translations_in_its_null_space() {
+    for mesh in [
+        subdyn::examples::cube(),
+        reference_mesh("fan5_open"),
+        reference_mesh("grid4_open"),
+    ] {
+        let r = default_refiner(&mesh);
+        let table = PatchTable::new(&r, &mesh.positions, 2).unwrap();
+        let q = quadrature(&table, 4).unwrap();
+        let k = stiffness_matrix(&q, table.to_level(), &MaterialParams::default()).unwrap();
+        assert_symmetric(&k, "K");
+        let ones = vec![1.0; k.num_rows()];
+        let k1 = k.apply_scalar(&ones).unwrap();
+        let scale = k.weights.iter().fold(0.0f64, |s, w| s.max(w.abs()));
+        assert!(
+            k1.iter()
+                .all(|v| v.abs() < 1e-12 * scale * k.num_rows() as Real),
+            "K·1 = {k1:?}"
+        );
+        let mut seed = 11;
+        for _ in 0..20 {
+            let x: Vec<Real> = (0..k.num_rows()).map(|_| lcg(&mut seed) - 0.5).collect();
+            assert!(
+                quad_form(&k, &x) >= -1e-12 * scale,
+                "K must be positive semi-definite"
+            );
+        }
+    }
+}
+
+/// On a mesh of regular patches, M (parameter measure) and K agree with a
+/// brute-force 10 × 10 Gauss-Legendre quadrature of the exact evaluator's
+/// stencils per base face.
+#[test]
+fn regular_patches_agree_with_brute_force_quadrature() {
+    let mesh = reference_mesh("torus_regular");
+    let r = default_refiner(&mesh);
+    let table = PatchTable::new(&r, &mesh.positions, 1).unwrap();
+    let q = quadrature(&table, 4).unwrap();
+    let params = MaterialParams::default();
+    let m = dense(&mass_matrix(&q, table.to_level(), None, params.mu).unwrap());
+    let k = dense(&stiffness_matrix(&q, table.to_level(), &params).unwrap());
+    let eval = LimitEvaluator::new(&r);
+    let n = mesh.num_vertices();
+    let mut mb = vec![vec![0.0; n]; n];
+    let mut kb = vec![vec![0.0; n]; n];
+    let gl = gauss_legendre(10);
+    let coefficients = [
+        params.alpha11,
+        params.alpha22,
+        params.beta11,
+        params.beta12,
+        params.beta22,
+    ];
+    for f in 0..mesh.num_faces() {
+        for &(u, wu) in &gl {
+            for &(v, wv) in &gl {
+                let s = eval.stencil(f, u, v).unwrap();
+                let w = wu * wv;
+                for (i, &a) in s.cols.iter().enumerate() {
+                    for (j, &b) in s.cols.iter().enumerate() {
+                        mb[a as usize][b as usize] +=
+                            params.mu * w * s.weights[0][i] * s.weights[0][j];
+                        for (t, c) in coefficients.iter().enumerate() {
+                            kb[a as usize][b as usize] +=
+                                c * w * s.weights[t + 1][i] * s.weights[t + 1][j];
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let worst = |x: &Vec<Vec<Real>>, y: &Vec<Vec<Real>>| {
+        x.iter()
+            .flatten()
+            .zip(y.iter().flatten())
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    };
+    assert!(worst(&m, &mb) < 1e-10, "M differs by {:e}", worst(&m, &mb));
+    assert!(worst(&k, &kb) < 1e-10, "K differs by {:e}", worst(&k, &kb));
+}
+
+#[test]
+fn pcg_solves_spd_systems_and_reports() {
+    let mesh = reference_mesh("fan5_open");
+    let r = default_refiner(&mesh);
+    let table = PatchTable::new(&r, &mesh.positions, 2).unwrap();
+    let q = quadrature(&table, 4).unwrap();
+    let m = mass_matrix(&q, table.to_level(), None, 1.0).unwrap();
+    let k = stiffness_matrix(&q, table.to_level(), &MaterialParams::default()).unwrap();
+    let a = m.linear_combination(1.0, &k, 10.0).unwrap();
+    let truth: Vec<Point3> = (0..a.num_rows())
+        .map(|i| Point3::new(i as Real, 1.0, -(i as Real).sqrt()))
+        .collect();
+    let b = a.apply(&truth).unwrap();
+    let mut x = vec![Point3::origin(); a.num_rows()];
+    let report = pcg(&a, &b, &mut x, &PcgParams::default()).unwrap();
+    assert!(report.converged, "{report:?}");
+    assert!(report.iterations > 0 && report.iterations <= 10 * a.num_rows());
+    for (x, t) in x.iter().zip(&truth) {
+        assert!((x - t).norm() < 1e-8, "{x} vs {t}");
+    }
+    // K alone is singular (translations): its diagonal is positive but CG on
+    // an inconsistent system must not claim convergence silently.
+    assert!(
+        pcg(
+            &StencilTable::zeros(3, 3),
+            &[Point3::origin(); 3],
+            &mut [Point3::origin(); 3],
+            &PcgParams::default()
+        )
+        .is_err()
+    );
+}
