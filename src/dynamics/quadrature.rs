@@ -138,8 +138,8 @@ pub fn quadrature(table: &PatchTable, order: usize) -> Result<Quadrature> {
 fn to_base_derivatives(s: &mut SampleStencil, inv: [[Real; 2]; 2]) {
     for k in 0..s.cols.len() {
         let d = crate::limit::chain_rule([1, 2, 3, 4, 5].map(|q| s.weights[q][k]), inv);
-        for q in 0..5 {
-            s.weights[q + 1][k] = d[q];
+        for (q, x) in d.into_iter().enumerate() {
+            s.weights[q + 1][k] = x;
         }
     }
 }

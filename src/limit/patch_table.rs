@@ -248,10 +248,10 @@ impl PatchTable {
             let mut b: [RowBuilder; 6] = Default::default();
             for i in 0..16 {
                 let (cols, ws) = self.grid_table.row(16 * f + i);
-                for q in 0..6 {
-                    if w[q][i] != 0.0 {
+                for (bq, wq) in b.iter_mut().zip(&w) {
+                    if wq[i] != 0.0 {
                         for (&c, &x) in cols.iter().zip(ws) {
-                            b[q].add(c, w[q][i] * x);
+                            bq.add(c, wq[i] * x);
                         }
                     }
                 }

@@ -387,9 +387,9 @@ impl StencilTable {
             )));
         }
         let mut t = self.clone();
-        for r in 0..t.num_rows() {
+        for (r, &x) in s.iter().enumerate() {
             for w in &mut t.weights[t.offsets[r]..t.offsets[r + 1]] {
-                *w *= s[r];
+                *w *= x;
             }
         }
         Ok(t)
