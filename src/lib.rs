@@ -27,6 +27,8 @@
 pub mod dynamics;
 pub mod error;
 pub mod examples;
+pub mod fit;
+pub mod forces;
 pub mod io;
 pub mod limit;
 pub mod math;

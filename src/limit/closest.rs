@@ -58,6 +58,9 @@ pub struct ClosestPoint {
     pub distance: Real,
     /// Unit normal of the surface there (zero where undefined).
     pub normal: Vector3,
+    /// The patch of the engine's [`PatchTable`] holding the point, and the
+    /// point's `(s, t)` in it (for [`PatchTable::stencil`]).
+    pub patch: (u32, [Real; 2]),
 }
 
 /// Closest-point queries against the limit surface of a fixed control mesh.
@@ -172,7 +175,13 @@ impl ClosestPointEngine {
             point: e.p,
             distance: d,
             normal,
+            patch: (f as u32, st),
         })
+    }
+
+    /// The patch table the engine searches.
+    pub fn table(&self) -> &PatchTable {
+        &self.table
     }
 
     /// Closest points of many queries, in parallel.

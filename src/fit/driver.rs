@@ -1,0 +1,178 @@
+//! The multilevel fitting driver (Qin, Mandal, Vemuri 1998, §6).
+//!
+//! At each level the control points follow the first-order (massless)
+//! dynamics `D ṗ + K p = f_p` with implicit Euler steps, the data springs
+//! treated implicitly:
+//!
+//! `(γ/Δt · D + K + Σ k JᵀJ) p⁺ = γ/Δt · D p + Σ k Jᵀ d`,
+//!
+//! refreshing every spring's closest point before each step. Each step
+//! minimises the spring + stiffness energy plus a proximal term, and the
+//! closest-point refresh can only lower the spring energy, so the energy
+//! `½ Σ k |x − d|² + ½ pᵀ K p` decreases monotonically (with fixed robust
+//! weights). When it settles (relative change below the tolerance) the error
+//! is measured; above the tolerance the control mesh is subdivided — the
+//! new control points `S p` describe the same surface — and the fit goes on.
+
+use std::time::Instant;
+
+use crate::dynamics::{
+    MaterialParams, PcgParams, damping_matrix, pcg, quadrature, stiffness_matrix,
+};
+use crate::error::{Error, Result};
+use crate::forces::{robust_weights, spring_system};
+use crate::limit::{ClosestPointEngine, ClosestPointParams};
+use crate::math::{Point3, Real, bbox_diagonal};
+use crate::mesh::{PointCloud, PolyMesh};
+use crate::subdivision::{RefineOptions, Refiner};
+
+use super::{ErrorStats, FitParams, FitReport, LevelReport, ToleranceStat};
+
+/// A fitted model and what it took.
+#[derive(Clone, Debug)]
+pub struct FitResult {
+    /// The control mesh of the finest level reached.
+    pub control: PolyMesh,
+    /// Per-level report.
+    pub report: FitReport,
+}
+
+/// Fits the limit surface of a control mesh, starting from `init`, to the
+/// points of `cloud`. `progress` is called after every implicit step with
+/// `(level, step, energy)`.
+pub fn fit_point_cloud(
+    cloud: &PointCloud,
+    init: &PolyMesh,
+    params: &FitParams,
+    progress: &mut dyn FnMut(usize, usize, Real),
+) -> Result<FitResult> {
+    params.check()?;
+    let points = &cloud.positions;
+    if points.len() < 4 {
+        return Err(Error::Input(format!(
+            "the point cloud has {} points; fitting needs at least 4",
+            points.len()
+        )));
+    }
+    let diameter = bbox_diagonal(points);
+    if !(diameter > 0.0 && diameter.is_finite()) {
+        return Err(Error::Input(
+            "all points coincide: the cloud has no extent".into(),
+        ));
+    }
+    let start = Instant::now();
+    let mut mesh = init.clone();
+    let mut levels = Vec::new();
+    let n = points.len() as Real;
+    let (converged, stop_reason) = loop {
+        let level = levels.len();
+        let level_start = Instant::now();
+        let refiner = Refiner::new(&mesh, &RefineOptions::default())?;
+        let mut engine = ClosestPointEngine::new(
+            &refiner,
+            &mesh.positions,
+            &ClosestPointParams {
+                level: params.patch_level,
+                ..Default::default()
+            },
+        )?;
+        let q = quadrature(engine.table(), params.quadrature_order)?;
+        let s = engine.table().to_level().clone();
+        let area: Real = q.weights.iter().sum();
+        let material = MaterialParams {
+            alpha11: params.tension / area,
+            alpha22: params.tension / area,
+            beta11: params.bending / area,
+            beta12: 2.0 * params.bending / area,
+            beta22: params.bending / area,
+            ..Default::default()
+        };
+        let k = stiffness_matrix(&q, &s, &material)?;
+        let d = damping_matrix(&q, &s, None, params.damping / area)?;
+        let kd = k.linear_combination(1.0, &d, 1.0)?;
+        let mut p = mesh.positions.clone();
+        let mut energy: Vec<Real> = Vec::new();
+        let mut cg_iterations = 0;
+        let mut steps = 0;
+        loop {
+            let closest = engine.closest_points(points)?;
+            let dist: Vec<Real> = closest.iter().map(|c| c.distance).collect();
+            let w = robust_weights(&dist, params.robust, 1e-6 * diameter);
+            let kw: Vec<Real> = w.iter().map(|w| w / n).collect();
+            let springs = spring_system(&engine, points, &closest, &kw)?;
+            let kp = k.apply(&p)?;
+            let e = springs.energy
+                + 0.5
+                    * kp.iter()
+                        .zip(&p)
+                        .map(|(a, b)| a.coords.dot(&b.coords))
+                        .sum::<Real>();
+            progress(level, steps, e);
+            let settled = energy.last().is_some_and(|&prev: &Real| {
+                (prev - e).abs() <= params.energy_tolerance * prev.abs()
+            });
+            energy.push(e);
+            if settled || steps >= params.max_steps {
+                break;
+            }
+            let a = kd.linear_combination(1.0, &springs.matrix, 1.0)?;
+            let dp = d.apply(&p)?;
+            let rhs: Vec<Point3> = springs
+                .rhs
+                .iter()
+                .zip(&dp)
+                .map(|(a, b)| Point3::from(a.coords + b.coords))
+                .collect();
+            let report = pcg(&a, &rhs, &mut p, &PcgParams::default())?;
+            cg_iterations += report.iterations;
+            engine.set_positions(&p)?;
+            steps += 1;
+        }
+        let closest = engine.closest_points(points)?;
+        let dist: Vec<Real> = closest.iter().map(|c| c.distance).collect();
+        let w = robust_weights(&dist, params.robust, 1e-6 * diameter);
+        let error = ErrorStats::new(&dist, diameter);
+        mesh.positions = p;
+        levels.push(LevelReport {
+            level,
+            control_points: mesh.num_vertices(),
+            faces: mesh.num_faces(),
+            steps,
+            cg_iterations,
+            seconds: level_start.elapsed().as_secs_f64(),
+            elapsed: start.elapsed().as_secs_f64(),
+            energy,
+            error,
+            rejected: w.iter().filter(|&&w| w == 0.0).count() as Real / n,
+        });
+        let stat = match params.tolerance_stat {
+            ToleranceStat::Max => error.max_pct,
+            ToleranceStat::P95 => error.p95_pct,
+            ToleranceStat::Rms => error.rms_pct,
+            ToleranceStat::Mean => error.mean_pct,
+        };
+        if stat <= params.tolerance_pct {
+            break (true, format!("tolerance met at level {level}"));
+        }
+        if level >= params.max_level {
+            break (
+                false,
+                format!("maximum level {level} reached above the tolerance"),
+            );
+        }
+        let h = refiner.refine_uniform(1)?;
+        let p1 = h.stencil(0).apply(&mesh.positions)?;
+        mesh = h.mesh(1, p1);
+    };
+    Ok(FitResult {
+        control: mesh,
+        report: FitReport {
+            points: points.len(),
+            diameter,
+            levels,
+            converged,
+            stop_reason,
+            seconds: start.elapsed().as_secs_f64(),
+        },
+    })
+}

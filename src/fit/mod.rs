@@ -1,0 +1,12 @@
+//! Fitting dynamic Catmull-Clark surfaces to point clouds (Qin, Mandal,
+//! Vemuri 1998, §6): data springs pull the surface, the thin plate under
+//! tension keeps it fair, and when the model settles above the tolerance it
+//! is subdivided and the fit continues at the finer level.
+
+mod driver;
+mod params;
+mod report;
+
+pub use driver::{FitResult, fit_point_cloud};
+pub use params::{FitParams, ToleranceStat};
+pub use report::{ErrorStats, FitReport, LevelReport};

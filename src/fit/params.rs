@@ -1,0 +1,120 @@
+//! Parameters of point-cloud fitting, with their defaults.
+
+use crate::error::{Error, Result};
+use crate::forces::RobustKernel;
+use crate::math::Real;
+
+/// Which error statistic the tolerance applies to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ToleranceStat {
+    /// The largest data-to-surface distance (the paper's error; any outlier
+    /// keeps it high).
+    Max,
+    /// The 95th percentile of the distances (default: robust to outliers).
+    P95,
+    /// The root mean square distance.
+    Rms,
+    /// The mean distance.
+    Mean,
+}
+
+/// Options of [`fit_point_cloud`](super::fit_point_cloud). Distances are in %
+/// of the data's bounding-box diagonal (the object's diameter).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitParams {
+    /// Stop when this statistic of the data-to-surface distances is at or
+    /// below `tolerance_pct` % of the diameter (default 0.1 %).
+    pub tolerance_pct: Real,
+    /// The statistic `tolerance_pct` applies to (default [`ToleranceStat::P95`]).
+    pub tolerance_stat: ToleranceStat,
+    /// Subdivision levels allowed above the initial control mesh (default 3).
+    pub max_level: usize,
+    /// Implicit steps per level at most (default 30).
+    pub max_steps: usize,
+    /// A level has settled when the energy changes by less than this fraction
+    /// between steps (default 1e-4).
+    pub energy_tolerance: Real,
+    /// Tension weight `λ_t`: `α11 = α22 = λ_t / F` with `F` the number of
+    /// faces (default 1e-3).
+    pub tension: Real,
+    /// Bending weight `λ_b`: `β11 = β22 = λ_b / F`, `β12 = 2 λ_b / F`
+    /// (default 1e-3).
+    pub bending: Real,
+    /// Damping over the time step, `γ / Δt`, relative to the total data
+    /// weight (default 0.05): the proximal term of the implicit step.
+    pub damping: Real,
+    /// Robust kernel of the data springs (default Tukey, 4.685 σ̂).
+    pub robust: RobustKernel,
+    /// Uniform level of the closest-point patches (default 2).
+    pub patch_level: usize,
+    /// Gauss-Legendre points per side of every polynomial piece (default 4).
+    pub quadrature_order: usize,
+}
+
+impl Default for FitParams {
+    fn default() -> Self {
+        FitParams {
+            tolerance_pct: 0.1,
+            tolerance_stat: ToleranceStat::P95,
+            max_level: 3,
+            max_steps: 30,
+            energy_tolerance: 1e-4,
+            tension: 1e-3,
+            bending: 1e-3,
+            damping: 0.05,
+            robust: RobustKernel::default(),
+            patch_level: 2,
+            quadrature_order: 4,
+        }
+    }
+}
+
+impl FitParams {
+    /// Checks every value; the error names the parameter.
+    pub fn check(&self) -> Result<()> {
+        let bad = |name: &str, v: Real, what: &str| {
+            Err(Error::Input(format!("fit parameter {name} = {v}: {what}")))
+        };
+        if !(self.tolerance_pct.is_finite()
+            && self.tolerance_pct > 0.0
+            && self.tolerance_pct < 100.0)
+        {
+            return bad(
+                "tolerance_pct",
+                self.tolerance_pct,
+                "expected 0 < tol < 100 (%)",
+            );
+        }
+        if self.max_level > 5 {
+            return bad(
+                "max_level",
+                self.max_level as Real,
+                "at most 5 levels (each multiplies the faces by 4)",
+            );
+        }
+        if self.max_steps == 0 || self.max_steps > 10_000 {
+            return bad("max_steps", self.max_steps as Real, "expected 1 to 10000");
+        }
+        for (name, v) in [
+            ("energy_tolerance", self.energy_tolerance),
+            ("tension", self.tension),
+            ("bending", self.bending),
+            ("damping", self.damping),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(name, v, "must be finite and ≥ 0");
+            }
+        }
+        if !(1..=4).contains(&self.patch_level) {
+            return bad("patch_level", self.patch_level as Real, "expected 1 to 4");
+        }
+        if !(2..=8).contains(&self.quadrature_order) {
+            return bad(
+                "quadrature_order",
+                self.quadrature_order as Real,
+                "expected 2 to 8",
+            );
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,97 @@
+//! What a fit did: per level, the size of the model, the work and the error.
+
+use serde::Serialize;
+
+use crate::math::Real;
+
+/// Statistics of data-to-surface distances, in absolute units and in % of the
+/// object's diameter (the data's bounding-box diagonal).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ErrorStats {
+    /// Largest distance (the paper's error).
+    pub max: Real,
+    /// Mean distance.
+    pub mean: Real,
+    /// Root mean square distance.
+    pub rms: Real,
+    /// 95th percentile (nearest rank).
+    pub p95: Real,
+    /// `max` in % of the diameter.
+    pub max_pct: Real,
+    /// `mean` in % of the diameter.
+    pub mean_pct: Real,
+    /// `rms` in % of the diameter.
+    pub rms_pct: Real,
+    /// `p95` in % of the diameter.
+    pub p95_pct: Real,
+}
+
+impl ErrorStats {
+    /// Statistics of `d` relative to `diameter`.
+    pub fn new(d: &[Real], diameter: Real) -> ErrorStats {
+        if d.is_empty() {
+            return ErrorStats::default();
+        }
+        let n = d.len() as Real;
+        let mut sorted = d.to_vec();
+        sorted.sort_by(|a, b| a.total_cmp(b));
+        let rank = ((0.95 * n).ceil() as usize).clamp(1, d.len()) - 1;
+        let max = sorted[d.len() - 1];
+        let mean = d.iter().sum::<Real>() / n;
+        let rms = (d.iter().map(|x| x * x).sum::<Real>() / n).sqrt();
+        let p95 = sorted[rank];
+        let pct = |x: Real| 100.0 * x / diameter;
+        ErrorStats {
+            max,
+            mean,
+            rms,
+            p95,
+            max_pct: pct(max),
+            mean_pct: pct(mean),
+            rms_pct: pct(rms),
+            p95_pct: pct(p95),
+        }
+    }
+}
+
+/// One subdivision level of a fit.
+#[derive(Clone, Debug, Serialize)]
+pub struct LevelReport {
+    /// Subdivision level above the initial control mesh.
+    pub level: usize,
+    /// Control points at this level.
+    pub control_points: usize,
+    /// Control faces at this level.
+    pub faces: usize,
+    /// Implicit steps taken.
+    pub steps: usize,
+    /// Conjugate-gradient iterations, summed over the steps.
+    pub cg_iterations: usize,
+    /// Wall time of the level, seconds.
+    pub seconds: Real,
+    /// Seconds since the fit started, at the end of this level.
+    pub elapsed: Real,
+    /// Total energy after each step (data springs + stiffness).
+    pub energy: Vec<Real>,
+    /// Distances from the data points to the surface at the end of the level.
+    pub error: ErrorStats,
+    /// Fraction of data points whose robust weight is zero (rejected outliers).
+    pub rejected: Real,
+}
+
+/// The whole fit.
+#[derive(Clone, Debug, Serialize)]
+pub struct FitReport {
+    /// Number of data points.
+    pub points: usize,
+    /// The data's bounding-box diagonal (the object's diameter).
+    pub diameter: Real,
+    /// Per level, in order.
+    pub levels: Vec<LevelReport>,
+    /// True when the tolerance was met.
+    pub converged: bool,
+    /// Why the fit stopped.
+    pub stop_reason: String,
+    /// Total wall time, seconds.
+    pub seconds: Real,
+}

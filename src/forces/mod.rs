@@ -1,0 +1,11 @@
+//! Forces on a dynamic subdivision surface, each distributed to the control
+//! points as `Jᵀ f` (Qin, Mandal, Vemuri 1998, §5): data springs from scan
+//! points with robust weights, inflation, and a point-drag spring.
+
+mod inflation;
+mod robust;
+mod springs;
+
+pub use inflation::inflation_force;
+pub use robust::{RobustKernel, robust_weights};
+pub use springs::{SpringSystem, drag_spring, spring_system};
