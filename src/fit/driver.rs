@@ -21,7 +21,7 @@ use crate::dynamics::{
 };
 use crate::error::{Error, Result};
 use crate::forces::{robust_weights, spring_system};
-use crate::limit::{ClosestPointEngine, ClosestPointParams};
+use crate::limit::{ClosestPointEngine, ClosestPointParams, PatchTable};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
 use crate::subdivision::{RefineOptions, Refiner};
@@ -76,8 +76,11 @@ pub fn fit_point_cloud(
                 ..Default::default()
             },
         )?;
-        let q = quadrature(engine.table(), params.quadrature_order)?;
-        let s = engine.table().to_level().clone();
+        // Quadrature on level-1 pieces: exact on regular faces (one bicubic
+        // each) and cheaper than the closest-point patches.
+        let qtable = PatchTable::new(&refiner, &mesh.positions, 1)?;
+        let q = quadrature(&qtable, params.quadrature_order)?;
+        let s = qtable.to_level();
         let area: Real = q.weights.iter().sum();
         let material = MaterialParams {
             alpha11: params.tension / area,
@@ -87,15 +90,20 @@ pub fn fit_point_cloud(
             beta22: params.bending / area,
             ..Default::default()
         };
-        let k = stiffness_matrix(&q, &s, &material)?;
-        let d = damping_matrix(&q, &s, None, params.damping / area)?;
+        let k = stiffness_matrix(&q, s, &material)?;
+        let d = damping_matrix(&q, s, None, params.damping / area)?;
         let kd = k.linear_combination(1.0, &d, 1.0)?;
         let mut p = mesh.positions.clone();
         let mut energy: Vec<Real> = Vec::new();
         let mut cg_iterations = 0;
         let mut steps = 0;
+        let mut hints: Option<Vec<(u32, [Real; 2])>> = None;
         loop {
-            let closest = engine.closest_points(points)?;
+            let closest = match &hints {
+                Some(h) => engine.closest_points_near(points, h)?,
+                None => engine.closest_points(points)?,
+            };
+            hints = Some(closest.iter().map(|c| c.patch).collect());
             let dist: Vec<Real> = closest.iter().map(|c| c.distance).collect();
             let w = robust_weights(&dist, params.robust, 1e-6 * diameter);
             let kw: Vec<Real> = w.iter().map(|w| w / n).collect();

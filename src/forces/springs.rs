@@ -54,8 +54,8 @@ pub fn spring_system(
             continue;
         }
         let sk = k.sqrt();
-        let j = table.stencil(c.patch.0 as usize, c.patch.1);
-        rows.push_row(j.cols.iter().zip(&j.weights[0]).map(|(&c, &w)| (c, sk * w)));
+        let (cols, w) = table.position_stencil(c.patch.0 as usize, c.patch.1);
+        rows.push_row(cols.iter().zip(&w).map(|(&c, &w)| (c, sk * w)));
         loads.push(Point3::from(sk * d.coords));
         energy += 0.5 * k * (c.point - d).norm_squared();
     }

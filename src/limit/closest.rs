@@ -147,18 +147,36 @@ impl ClosestPointEngine {
 
     /// The closest limit-surface point to `q`.
     pub fn closest_point(&self, q: Point3) -> Result<ClosestPoint> {
+        self.closest_point_near(q, None)
+    }
+
+    /// The closest point to `q`, also trying a start at `hint` (a patch and
+    /// its `(s, t)`, e.g. the previous answer while the surface moves); with
+    /// a hint only the nearest seed of the k-d tree is tried besides it.
+    pub fn closest_point_near(
+        &self,
+        q: Point3,
+        hint: Option<(u32, [Real; 2])>,
+    ) -> Result<ClosestPoint> {
         if !q.coords.iter().all(|c| c.is_finite()) {
             return Err(Error::Input(format!(
                 "query point ({}, {}, {}) is not finite",
                 q.x, q.y, q.z
             )));
         }
-        let k = NonZero::new(self.params.candidates.min(self.seeds.len()))
-            .unwrap_or(NonZero::<usize>::MIN);
+        let candidates = if hint.is_some() {
+            1
+        } else {
+            self.params.candidates
+        };
+        let k = NonZero::new(candidates.min(self.seeds.len())).unwrap_or(NonZero::<usize>::MIN);
         let near = self.tree.nearest_n::<SquaredEuclidean>(&[q.x, q.y, q.z], k);
+        let starts = near
+            .iter()
+            .map(|nn| self.seeds[nn.item as usize])
+            .chain(hint.filter(|h| (h.0 as usize) < self.table.num_patches()));
         let mut best: Option<(Real, usize, [Real; 2], PatchPoint)> = None;
-        for nn in near {
-            let (f, st) = self.seeds[nn.item as usize];
+        for (f, st) in starts {
             let (f, st, e) = self.descend(q, f as usize, st)?;
             let d = (e.p - q).norm();
             if best.as_ref().is_none_or(|b| d < b.0) {
@@ -182,6 +200,27 @@ impl ClosestPointEngine {
     /// The patch table the engine searches.
     pub fn table(&self) -> &PatchTable {
         &self.table
+    }
+
+    /// Closest points of many queries, each also started from its hint (see
+    /// [`closest_point_near`](Self::closest_point_near)), in parallel.
+    pub fn closest_points_near(
+        &self,
+        queries: &[Point3],
+        hints: &[(u32, [Real; 2])],
+    ) -> Result<Vec<ClosestPoint>> {
+        if hints.len() != queries.len() {
+            return Err(Error::Input(format!(
+                "{} hints for {} queries",
+                hints.len(),
+                queries.len()
+            )));
+        }
+        queries
+            .par_iter()
+            .zip(hints)
+            .map(|(&q, &h)| self.closest_point_near(q, Some(h)))
+            .collect()
     }
 
     /// Closest points of many queries, in parallel.

@@ -65,6 +65,8 @@ struct Leaf {
     jac: [[Real; 2]; 2],
     off: [Real; 2],
     grid: Option<Vec<Real>>,
+    /// The control points at the current positions (cleared by `set_positions`).
+    points: OnceLock<[Point3; 16]>,
 }
 
 /// Position and derivatives `∂s, ∂t, ∂ss, ∂st, ∂tt` in a patch's own `(s, t)`.
@@ -170,6 +172,13 @@ impl PatchTable {
         crate::mesh::check_finite(positions)?;
         self.level_positions = self.to_level.apply(positions)?;
         self.grid_points = self.grid_table.apply(&self.level_positions)?;
+        for patch in &mut self.patches {
+            if let Some(tree) = patch.tree.get_mut() {
+                for leaf in &mut tree.leaves {
+                    leaf.points = OnceLock::new();
+                }
+            }
+        }
         self.positions = positions.to_vec();
         Ok(())
     }
@@ -211,16 +220,18 @@ impl PatchTable {
             let x = local(leaf);
             if let (Some(rows), true) = (&leaf.grid, inside(x)) {
                 let nc = cols.len().max(1);
-                let grid: [Point3; 16] = std::array::from_fn(|k| {
-                    Point3::from(
-                        rows[k * nc..(k + 1) * nc]
-                            .iter()
-                            .zip(cols)
-                            .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
-                            .sum::<Vector3>(),
-                    )
+                let grid = leaf.points.get_or_init(|| {
+                    std::array::from_fn(|k| {
+                        Point3::from(
+                            rows[k * nc..(k + 1) * nc]
+                                .iter()
+                                .zip(cols)
+                                .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
+                                .sum::<Vector3>(),
+                        )
+                    })
                 });
-                let e = bicubic(&grid, [x[0].clamp(0.0, 1.0), x[1].clamp(0.0, 1.0)]);
+                let e = bicubic(grid, [x[0].clamp(0.0, 1.0), x[1].clamp(0.0, 1.0)]);
                 return Ok(PatchPoint {
                     p: e.p,
                     d: chain(e.d, leaf.jac),
@@ -292,6 +303,27 @@ impl PatchTable {
             }
         }
         evaluate_face(&self.level, &self.sharp, f, st[0], st[1])
+    }
+
+    /// The position row of [`stencil`](Self::stencil) alone (cheaper):
+    /// columns (level-`L` vertices) and weights.
+    pub fn position_stencil(&self, f: usize, st: [Real; 2]) -> (Vec<u32>, Vec<Real>) {
+        if self.patches[f].regular {
+            let w = patch_weights(st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0));
+            let mut b = RowBuilder::default();
+            for (i, &wi) in w[0].iter().enumerate() {
+                if wi != 0.0 {
+                    let (cols, ws) = self.grid_table.row(16 * f + i);
+                    for (&c, &x) in cols.iter().zip(ws) {
+                        b.add(c, wi * x);
+                    }
+                }
+            }
+            return b.entries().unzip();
+        }
+        let s = self.stencil(f, st);
+        let [w0, ..] = s.weights;
+        (s.cols, w0)
     }
 
     /// The refinement `P_L = S P_0` from the control points to level `L`.
@@ -394,6 +426,7 @@ impl PatchTable {
                     jac,
                     off,
                     grid: None,
+                    points: OnceLock::new(),
                 });
                 continue;
             }
@@ -408,6 +441,7 @@ impl PatchTable {
                         jac: cj,
                         off: co,
                         grid: Some(refined.grid_rows(cf)),
+                        points: OnceLock::new(),
                     });
                 } else {
                     stack.push((refined.extract(cf), cj, co, depth + 1));
