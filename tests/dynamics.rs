@@ -166,7 +166,7 @@ fn mass_matrix_is_spd_and_sums_to_mu_times_area() {
     // limit surface (limit mask 9/24 − 3·4/24 + 3·1/24 = 0), so it is in the
     // null space. One level finer the map to the limit surface is injective.
     let checker: Vec<Real> = (0..8)
-        .map(|i: u32| if i.count_ones() % 2 == 0 { 1.0 } else { -1.0 })
+        .map(|i: u32| if i.count_ones().is_multiple_of(2) { 1.0 } else { -1.0 })
         .collect();
     assert!(quad_form(&m, &checker).abs() < 1e-12);
     for mesh in [

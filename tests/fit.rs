@@ -1,0 +1,191 @@
+//! Fitting point clouds with dynamic Catmull-Clark surfaces.
+
+use subdyn::fit::{FitParams, fit_point_cloud};
+use subdyn::forces::RobustKernel;
+use subdyn::limit::tessellate;
+use subdyn::math::{Point3, Real, Vector3};
+use subdyn::mesh::{PointCloud, PolyMesh};
+use subdyn::subdivision::{RefineOptions, Refiner};
+
+struct Rng(u64);
+impl Rng {
+    fn uniform(&mut self) -> Real {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 11) as Real / (1u64 << 53) as Real
+    }
+    fn gauss(&mut self) -> Real {
+        (-2.0 * self.uniform().max(1e-300).ln()).sqrt()
+            * (std::f64::consts::TAU * self.uniform()).cos()
+    }
+}
+
+/// `n` points on the unit sphere, with Gaussian noise of `sigma` along the radius.
+fn sphere_scan(n: usize, sigma: Real, seed: u64) -> PointCloud {
+    let mut rng = Rng(seed);
+    let pts = (0..n)
+        .map(|_| {
+            let z = 2.0 * rng.uniform() - 1.0;
+            let t = std::f64::consts::TAU * rng.uniform();
+            let r = (1.0 - z * z).sqrt();
+            Point3::from(Vector3::new(r * t.cos(), r * t.sin(), z) * (1.0 + sigma * rng.gauss()))
+        })
+        .collect();
+    PointCloud::new(pts, None).unwrap()
+}
+
+/// The cube [-1, 1]³ as a control mesh.
+fn cube_cage() -> PolyMesh {
+    let mut cube = subdyn::examples::cube();
+    for p in &mut cube.positions {
+        *p = Point3::from((p.coords - Vector3::new(0.5, 0.5, 0.5)) * 2.0);
+    }
+    cube
+}
+
+/// Largest and mean distance of a dense limit tessellation to the unit sphere.
+fn sphere_deviation(control: &PolyMesh) -> (Real, Real) {
+    let r = Refiner::new(control, &RefineOptions::default()).unwrap();
+    let (tess, _) = tessellate(&r, &control.positions, 4).unwrap();
+    let d: Vec<Real> = tess
+        .positions
+        .iter()
+        .map(|p| (p.coords.norm() - 1.0).abs())
+        .collect();
+    (
+        d.iter().cloned().fold(0.0, f64::max),
+        d.iter().sum::<Real>() / d.len() as Real,
+    )
+}
+
+#[test]
+fn noisy_sphere_fits_below_the_noise_level() {
+    let diag = 2.0 * 3f64.sqrt();
+    let sigma = 0.001 * diag; // 0.1 % of the diagonal
+    let cloud = sphere_scan(6000, sigma, 1);
+    let result = fit_point_cloud(
+        &cloud,
+        &cube_cage(),
+        &FitParams::default(),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    let (max, mean) = sphere_deviation(&result.control);
+    assert!(mean < sigma, "mean deviation {mean:e} vs noise {sigma:e}");
+    assert!(max < 0.01 * diag, "max deviation {max:e}");
+    let report = &result.report;
+    assert!(
+        report.levels.len() >= 2,
+        "the fit must subdivide at least once"
+    );
+    for w in report.levels.windows(2) {
+        assert!(w[1].control_points > w[0].control_points);
+        assert!(
+            w[1].error.rms <= w[0].error.rms * 1.01,
+            "RMS error must not grow with the level"
+        );
+    }
+}
+
+#[test]
+fn energy_decreases_monotonically_without_robust_reweighting() {
+    let cloud = sphere_scan(2000, 0.0, 2);
+    let params = FitParams {
+        robust: RobustKernel::None,
+        max_level: 1,
+        max_steps: 12,
+        energy_tolerance: 0.0,
+        ..Default::default()
+    };
+    let result = fit_point_cloud(&cloud, &cube_cage(), &params, &mut |_, _, _| {}).unwrap();
+    for level in &result.report.levels {
+        for w in level.energy.windows(2) {
+            assert!(
+                w[1] <= w[0] * (1.0 + 1e-12),
+                "level {}: energy rose {:?}",
+                level.level,
+                level.energy
+            );
+        }
+    }
+}
+
+#[test]
+fn outliers_do_not_pull_the_surface() {
+    let diag = 2.0 * 3f64.sqrt();
+    let mut cloud = sphere_scan(4000, 0.0005 * diag, 3);
+    let mut rng = Rng(99);
+    for _ in 0..200 {
+        // 5 % outliers, uniform in the bounding box enlarged by half.
+        let p = Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 3.0
+            - Vector3::new(1.5, 1.5, 1.5);
+        cloud.positions.push(Point3::from(p));
+    }
+    let result = fit_point_cloud(
+        &cloud,
+        &cube_cage(),
+        &FitParams::default(),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    let (_, mean) = sphere_deviation(&result.control);
+    assert!(
+        mean < 0.002 * diag,
+        "mean deviation {mean:e} with 5 % outliers"
+    );
+    assert!(
+        result.report.levels.last().unwrap().rejected > 0.02,
+        "outliers must be rejected"
+    );
+}
+
+#[test]
+fn bad_inputs_are_errors() {
+    let cage = cube_cage();
+    let empty = PointCloud::default();
+    assert!(fit_point_cloud(&empty, &cage, &FitParams::default(), &mut |_, _, _| {}).is_err());
+    let three = PointCloud::new(
+        vec![
+            Point3::origin(),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(0.0, 1.0, 0.0),
+        ],
+        None,
+    )
+    .unwrap();
+    let e = fit_point_cloud(&three, &cage, &FitParams::default(), &mut |_, _, _| {}).unwrap_err();
+    assert!(e.to_string().contains("3 points"), "{e}");
+    let same = PointCloud::new(vec![Point3::new(1.0, 2.0, 3.0); 20], None).unwrap();
+    assert!(fit_point_cloud(&same, &cage, &FitParams::default(), &mut |_, _, _| {}).is_err());
+    // A non-manifold initial mesh: three quads sharing one edge.
+    let p = |x: Real, y: Real, z: Real| Point3::new(x, y, z);
+    let fin = PolyMesh::from_faces(
+        vec![
+            p(0.0, 0.0, 0.0),
+            p(1.0, 0.0, 0.0),
+            p(0.0, 1.0, 0.0),
+            p(1.0, 1.0, 0.0),
+            p(0.0, -1.0, 0.0),
+            p(1.0, -1.0, 0.0),
+            p(0.0, 0.0, 1.0),
+            p(1.0, 0.0, 1.0),
+        ],
+        &[vec![0, 1, 3, 2], vec![1, 0, 4, 5], vec![0, 1, 7, 6]],
+    )
+    .unwrap();
+    let e = fit_point_cloud(
+        &sphere_scan(100, 0.0, 4),
+        &fin,
+        &FitParams::default(),
+        &mut |_, _, _| {},
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("non-manifold"), "{e}");
+    let bad = FitParams {
+        tolerance_pct: -1.0,
+        ..Default::default()
+    };
+    assert!(fit_point_cloud(&sphere_scan(100, 0.0, 5), &cage, &bad, &mut |_, _, _| {}).is_err());
+}

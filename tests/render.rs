@@ -1,0 +1,599 @@
+//! Invariants of the software rasteriser (`subdyn::render`) on tiny
+//! hand-built scenes, and end-to-end runs of `subdyn render`.
+//!
+//! Every input is built by the test itself: a unit cube, jittered square
+//! grids, a few points. CLI runs happen in a temporary directory and check
+//! the PNG by decoding it with the `image` crate.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use subdyn::math::{Point3, Real};
+use subdyn::mesh::{PointCloud, PolyMesh};
+use subdyn::render::{
+    Camera, CloudLayer, ColorMap, MeshLayer, Picture, Projection, RenderOptions, Rgb, Scene,
+    render, write_png,
+};
+
+const WHITE: Rgb = [255, 255, 255];
+
+/// Options for a head-on orthographic view (azimuth 0, elevation 0) of a `w × h` picture.
+fn head_on(w: u32, h: u32, margin: Real) -> RenderOptions {
+    RenderOptions {
+        width: w,
+        height: h,
+        azimuth: 0.0,
+        elevation: 0.0,
+        margin,
+        ..RenderOptions::default()
+    }
+}
+
+/// The unit cube `[0, 1]³`.
+fn unit_cube() -> PolyMesh {
+    subdyn::examples::cube()
+}
+
+/// A `n × n` grid of quads over `[0, 1]²` at height `z`, interior vertices
+/// jittered within the plane by up to `jitter` of a cell, each quad split into two triangles along a
+/// diagonal that alternates, so edges run in many directions.
+fn jittered_plane(n: usize, jitter: Real, z: Real) -> PolyMesh {
+    let mut positions = Vec::new();
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut random = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as Real / (1u64 << 53) as Real - 0.5
+    };
+    for j in 0..=n {
+        for i in 0..=n {
+            let interior = i > 0 && i < n && j > 0 && j < n;
+            let (dx, dy) = if interior {
+                (random() * jitter, random() * jitter)
+            } else {
+                (0.0, 0.0)
+            };
+            let h = 1.0 / n as Real;
+            positions.push(Point3::new((i as Real + dx) * h, (j as Real + dy) * h, z));
+        }
+    }
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let mut faces = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if (i + j) % 2 == 0 {
+                faces.push(vec![a, b, c]);
+                faces.push(vec![a, c, d]);
+            } else {
+                faces.push(vec![a, b, d]);
+                faces.push(vec![b, c, d]);
+            }
+        }
+    }
+    PolyMesh::from_faces(positions, &faces).unwrap()
+}
+
+/// Columns and rows `[x0, x1) × [y0, y1)` of the non-background pixels.
+fn ink_box(p: &Picture) -> Option<(u32, u32, u32, u32)> {
+    let mut b: Option<(u32, u32, u32, u32)> = None;
+    for y in 0..p.height() {
+        for x in 0..p.width() {
+            if p.get(x, y) != Some(WHITE) {
+                b = Some(match b {
+                    None => (x, y, x + 1, y + 1),
+                    Some((x0, y0, x1, y1)) => (x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1)),
+                });
+            }
+        }
+    }
+    b
+}
+
+#[test]
+fn a_unit_cube_seen_head_on_covers_exactly_the_fitted_square() {
+    let cube = unit_cube();
+    for (w, h) in [(200u32, 200u32), (300, 200), (200, 260)] {
+        let scene = Scene {
+            meshes: vec![MeshLayer::new(&cube)],
+            ..Scene::default()
+        };
+        let picture = render(&scene, &head_on(w, h, 0.1)).unwrap();
+        // Fitted side: the smaller side less 10 % of it on each end; centred.
+        let side = w.min(h) * 8 / 10;
+        let (x0, y0) = ((w - side) / 2, (h - side) / 2);
+        for y in 0..h {
+            for x in 0..w {
+                let inside = (x0..x0 + side).contains(&x) && (y0..y0 + side).contains(&y);
+                let drawn = picture.get(x, y) != Some(WHITE);
+                assert_eq!(drawn, inside, "{w}×{h}: pixel ({x}, {y})");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_near_triangle_hides_the_far_one_whatever_the_drawing_order() {
+    let tri = |z: Real| {
+        PolyMesh::from_faces(
+            vec![
+                Point3::new(0.0, 0.0, z),
+                Point3::new(1.0, 0.0, z),
+                Point3::new(0.3, 1.0, z),
+            ],
+            &[vec![0, 1, 2]],
+        )
+        .unwrap()
+    };
+    let (near, far) = (tri(1.0), tri(0.0));
+    let mut near_layer = MeshLayer::new(&near);
+    near_layer.color = [250, 0, 0];
+    let mut far_layer = MeshLayer::new(&far);
+    far_layer.color = [0, 0, 250];
+    let options = head_on(120, 100, 0.05);
+    let draw = |layers: Vec<MeshLayer>| {
+        render(
+            &Scene {
+                meshes: layers,
+                ..Scene::default()
+            },
+            &options,
+        )
+        .unwrap()
+    };
+    let a = draw(vec![near_layer.clone(), far_layer.clone()]);
+    let b = draw(vec![far_layer, near_layer]);
+    assert_eq!(a, b);
+    let covered: Vec<Rgb> = a.pixels().iter().copied().filter(|&c| c != WHITE).collect();
+    assert!(covered.len() > 2000);
+    assert!(
+        covered.iter().all(|c| c[0] > 150 && c[2] == 0),
+        "a far (blue) pixel shows"
+    );
+}
+
+#[test]
+fn a_tessellated_square_seen_head_on_has_no_cracks() {
+    // Unjittered grids put pixel centres exactly on the diagonals (the fill
+    // rule decides them); jittered ones give edges in every direction.
+    for (n, jitter, w, h) in [
+        (18, 0.0, 200, 200),
+        (10, 0.0, 120, 120),
+        (17, 0.6, 97, 89),
+        (40, 0.6, 200, 200),
+        (64, 0.6, 331, 257),
+    ] {
+        let plane = jittered_plane(n, jitter, 0.0);
+        let scene = Scene {
+            meshes: vec![MeshLayer::new(&plane)],
+            ..Scene::default()
+        };
+        let picture = render(&scene, &head_on(w, h, 0.05)).unwrap();
+        let (x0, y0, x1, y1) = ink_box(&picture).expect("the plane is drawn");
+        let mut holes = 0;
+        for y in y0..y1 {
+            for x in x0..x1 {
+                holes += usize::from(picture.get(x, y) == Some(WHITE));
+            }
+        }
+        assert_eq!(
+            holes, 0,
+            "{n}×{n} grid (jitter {jitter}) at {w}×{h}: background pixels inside the square"
+        );
+        // And the square is where the fit puts it.
+        let side = w.min(h) - 2 * (w.min(h) as Real * 0.05).round() as u32;
+        assert!((x1 - x0).abs_diff(side) <= 1 && (y1 - y0).abs_diff(side) <= 1);
+    }
+}
+
+#[test]
+fn point_splats_appear_at_their_projected_positions() {
+    let points = vec![
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(1.0, 0.2, 0.1),
+        Point3::new(0.3, 1.0, -0.4),
+        Point3::new(0.6, 0.5, 0.9),
+    ];
+    let cloud = PointCloud::new(points.clone(), None).unwrap();
+    for (az, el, projection) in [
+        (0.0, 0.0, Projection::Orthographic),
+        (40.0, 25.0, Projection::Orthographic),
+        (-70.0, 60.0, Projection::Perspective { fov_deg: 30.0 }),
+    ] {
+        let mut layer = CloudLayer::new(&cloud);
+        layer.radius = 3.0;
+        let scene = Scene {
+            clouds: vec![layer],
+            ..Scene::default()
+        };
+        let options = RenderOptions {
+            width: 160,
+            height: 120,
+            azimuth: az,
+            elevation: el,
+            projection,
+            margin: 0.1,
+            ..RenderOptions::default()
+        };
+        let picture = render(&scene, &options).unwrap();
+        let (lo, hi) = subdyn::math::bounding_box(&points).unwrap();
+        let mut camera = Camera::orbit(lo, hi, az, el, projection).unwrap();
+        camera.fit(&points, [0.0, 0.0, 160.0, 120.0], 0.1);
+        for p in &points {
+            let s = camera.project(p);
+            let (x, y) = (s.x.floor() as u32, s.y.floor() as u32);
+            assert_ne!(
+                picture.get(x, y),
+                Some(WHITE),
+                "view {az},{el}: point {p:?} at ({x}, {y})"
+            );
+        }
+        // Four disks of radius 3 (about 28 pixels each), nothing else.
+        let drawn = picture.count(|c| c != WHITE);
+        assert!(
+            (4 * 20..=4 * 32).contains(&drawn),
+            "view {az},{el}: {drawn} pixels drawn"
+        );
+    }
+}
+
+#[test]
+fn the_colour_map_ends_are_viridis_ends() {
+    assert_eq!(ColorMap::Viridis.color(0.0), [68, 1, 84]);
+    assert_eq!(ColorMap::Viridis.color(1.0), [253, 231, 37]);
+    assert_eq!(ColorMap::Viridis.color(-3.0), [68, 1, 84]);
+    assert_eq!(ColorMap::Viridis.color(3.0), [253, 231, 37]);
+    // Lightness rises monotonically (viridis is sequential).
+    let luma = |c: Rgb| 0.2126 * c[0] as Real + 0.7152 * c[1] as Real + 0.0722 * c[2] as Real;
+    let samples: Vec<Real> = (0..=50)
+        .map(|i| luma(ColorMap::Viridis.color(i as Real / 50.0)))
+        .collect();
+    assert!(samples.windows(2).all(|w| w[1] > w[0]));
+}
+
+#[test]
+fn a_legend_is_drawn_when_and_only_when_colouring() {
+    let cube = unit_cube();
+    let heights: Vec<Real> = cube.positions.iter().map(|p| p.y).collect();
+    let options = RenderOptions {
+        width: 480,
+        height: 360,
+        ..RenderOptions::default()
+    };
+    let strip = |p: &Picture| -> Vec<Rgb> {
+        (0..p.height())
+            .flat_map(|y| (p.width() * 85 / 100..p.width()).map(move |x| (x, y)))
+            .filter_map(|(x, y)| p.get(x, y))
+            .collect()
+    };
+    let plain = Scene {
+        meshes: vec![MeshLayer::new(&cube)],
+        ..Scene::default()
+    };
+    let picture = render(&plain, &options).unwrap();
+    assert!(
+        strip(&picture).iter().all(|&c| c == WHITE),
+        "legend without scalars"
+    );
+
+    let coloured = Scene {
+        meshes: vec![MeshLayer::new(&cube).with_scalars(&heights)],
+        ..Scene::default()
+    };
+    let picture = render(&coloured, &options).unwrap();
+    let legend = strip(&picture);
+    for end in [0.0, 1.0] {
+        let c = ColorMap::Viridis.color(end);
+        assert!(legend.contains(&c), "legend bar lacks the colour of {end}");
+    }
+    // Tick labels: dark text ink.
+    assert!(legend.iter().filter(|&&c| c == [30, 30, 30]).count() > 100);
+    // The surface itself (left of the legend) uses the map: some pixels are purple, not grey.
+    let purple = (0..picture.height())
+        .flat_map(|y| (0..picture.width() * 3 / 4).map(move |x| (x, y)))
+        .filter_map(|(x, y)| picture.get(x, y))
+        .any(|c| c[2] > c[1] + 30 && c[0] > c[1] + 20);
+    assert!(purple);
+}
+
+#[test]
+fn geometry_is_never_clipped_in_any_view() {
+    let cube = unit_cube();
+    for projection in [
+        Projection::Orthographic,
+        Projection::Perspective { fov_deg: 30.0 },
+    ] {
+        for (az, el) in [
+            (0.0, 0.0),
+            (30.0, 20.0),
+            (135.0, -45.0),
+            (270.0, 90.0),
+            (10.0, -90.0),
+        ] {
+            let scene = Scene {
+                meshes: vec![MeshLayer::new(&cube)],
+                ..Scene::default()
+            };
+            let options = RenderOptions {
+                width: 100,
+                height: 80,
+                azimuth: az,
+                elevation: el,
+                projection,
+                margin: 0.1,
+                ..RenderOptions::default()
+            };
+            let picture = render(&scene, &options).unwrap();
+            let (x0, y0, x1, y1) = ink_box(&picture).unwrap();
+            assert!(
+                x0 >= 7 && y0 >= 7 && x1 <= 93 && y1 <= 73,
+                "{projection:?} {az},{el}: {x0},{y0}..{x1},{y1}"
+            );
+            // Fitted: touches the margin on at least one axis.
+            assert!(
+                x0 <= 9 || y0 <= 9,
+                "{projection:?} {az},{el}: not fitted ({x0}, {y0})"
+            );
+        }
+    }
+}
+
+#[test]
+fn supersampling_keeps_the_size_and_softens_edges() {
+    let cube = unit_cube();
+    let scene = Scene {
+        meshes: vec![MeshLayer::new(&cube)],
+        ..Scene::default()
+    };
+    let hard = render(
+        &scene,
+        &RenderOptions {
+            width: 120,
+            height: 90,
+            ..RenderOptions::default()
+        },
+    )
+    .unwrap();
+    let soft = render(
+        &scene,
+        &RenderOptions {
+            width: 120,
+            height: 90,
+            supersample: 2,
+            ..RenderOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!((soft.width(), soft.height()), (120, 90));
+    let distinct = |p: &Picture| {
+        p.pixels()
+            .iter()
+            .collect::<std::collections::HashSet<_>>()
+            .len()
+    };
+    assert!(distinct(&soft) > distinct(&hard));
+}
+
+#[test]
+fn bad_options_are_errors_not_panics() {
+    let cube = unit_cube();
+    let scene = Scene {
+        meshes: vec![MeshLayer::new(&cube)],
+        ..Scene::default()
+    };
+    for options in [
+        RenderOptions {
+            width: 0,
+            ..RenderOptions::default()
+        },
+        RenderOptions {
+            height: 8193,
+            ..RenderOptions::default()
+        },
+        RenderOptions {
+            elevation: 91.0,
+            ..RenderOptions::default()
+        },
+        RenderOptions {
+            azimuth: Real::NAN,
+            ..RenderOptions::default()
+        },
+        RenderOptions {
+            supersample: 5,
+            ..RenderOptions::default()
+        },
+        RenderOptions {
+            projection: Projection::Perspective { fov_deg: 0.0 },
+            ..RenderOptions::default()
+        },
+    ] {
+        assert!(render(&scene, &options).is_err(), "{options:?}");
+    }
+    let heights = vec![0.0; 3];
+    let wrong = Scene {
+        meshes: vec![MeshLayer::new(&cube).with_scalars(&heights)],
+        ..Scene::default()
+    };
+    assert!(render(&wrong, &RenderOptions::default()).is_err());
+    assert!(render(&Scene::default(), &RenderOptions::default()).is_err());
+}
+
+#[test]
+fn write_png_round_trips_and_leaves_nothing_on_failure() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut picture = Picture::new(7, 5, [10, 20, 30]).unwrap();
+    picture.set(6, 4, [200, 100, 0]);
+    let path = dir.path().join("p.png");
+    write_png(&path, &picture).unwrap();
+    let back = image::open(&path).unwrap().to_rgb8();
+    assert_eq!(back.dimensions(), (7, 5));
+    assert_eq!(back.get_pixel(6, 4).0, [200, 100, 0]);
+    assert_eq!(back.get_pixel(0, 0).0, [10, 20, 30]);
+    assert!(write_png(&dir.path().join("missing/p.png"), &picture).is_err());
+    assert!(write_png(&dir.path().join("p.jpg"), &picture).is_err());
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+// ---------------------------------------------------------------------------
+// The command line
+
+/// Runs `subdyn` with `args` in `dir`.
+fn subdyn(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_subdyn"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the subdyn binary runs")
+}
+
+/// A directory holding `cube.obj` (the unit cube as quads).
+fn cube_dir() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = unit_cube();
+    subdyn::io::write_mesh(dir.path().join("cube.obj"), &cube, None).unwrap();
+    dir
+}
+
+/// Asserts a failed run: exit 1, one `subdyn: error: …` line mentioning
+/// `needle`, and no file other than `cube.obj` left in `dir`.
+fn assert_fails(dir: &Path, args: &[&str], needle: &str) {
+    let out = subdyn(dir, args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{args:?}: {stderr}");
+    assert!(stderr.starts_with("subdyn: error: "), "{args:?}: {stderr}");
+    assert!(
+        stderr.contains(needle),
+        "{args:?}: {stderr:?} lacks {needle:?}"
+    );
+    let names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n != "cube.obj")
+        .collect();
+    assert!(names.is_empty(), "{args:?} left {names:?}");
+}
+
+#[test]
+fn cli_writes_a_png_of_the_requested_size() {
+    let dir = cube_dir();
+    let out = subdyn(
+        dir.path(),
+        &[
+            "render", "cube.obj", "-o", "cube.png", "--size", "160,120", "--view", "-30,25",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let png = image::open(dir.path().join("cube.png")).unwrap().to_rgb8();
+    assert_eq!(png.dimensions(), (160, 120));
+    assert!(png.pixels().filter(|p| p.0 != WHITE).count() > 2000);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("160×120"));
+}
+
+#[test]
+fn cli_draws_limit_surfaces_cages_points_and_distances() {
+    let dir = cube_dir();
+    let d = dir.path();
+    std::fs::write(d.join("pts.xyz"), "0 0 0\n1 1 1\n0.5 0.5 1.2\n").unwrap();
+    let runs: [&[&str]; 4] = [
+        &[
+            "render", "cube.obj", "-o", "a.png", "--limit", "4", "--cage", "--ssaa", "--title",
+            "cube",
+        ],
+        &[
+            "render",
+            "pts.xyz",
+            "-o",
+            "b.png",
+            "--point-size",
+            "3",
+            "--perspective",
+        ],
+        &[
+            "render", "cube.obj", "-o", "c.png", "--points", "pts.xyz", "--cage",
+        ],
+        &[
+            "render",
+            "cube.obj",
+            "-o",
+            "d.png",
+            "--limit",
+            "3",
+            "--color-by-distance-to",
+            "cube.obj",
+        ],
+    ];
+    for args in runs {
+        let out = subdyn(d, args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let png = image::open(d.join(args[3])).unwrap().to_rgb8();
+        assert_eq!(png.dimensions(), (640, 480));
+    }
+    // Distances to the cage: the legend shows the colour map's ends.
+    let png = image::open(d.join("d.png")).unwrap().to_rgb8();
+    for end in [0.0, 1.0] {
+        let c = ColorMap::Viridis.color(end);
+        assert!(png.pixels().any(|p| p.0 == c), "no legend colour for {end}");
+    }
+}
+
+#[test]
+fn cli_rejects_bad_sizes_views_and_outputs_with_one_line_and_no_file() {
+    let dir = cube_dir();
+    let d = dir.path();
+    for (args, needle) in [
+        (vec!["--size", "0,480"], "--size"),
+        (vec!["--size", "9000,100"], "8192"),
+        (vec!["--size", "640x480"], "W,H"),
+        (vec!["--size", "-5,10"], "--size"),
+        (vec!["--view", "30,95"], "elevation"),
+        (vec!["--view", "abc"], "AZ,EL"),
+        (vec!["--view", "1,2,3"], "AZ,EL"),
+        (vec!["--view", "nan,0"], "azimuth"),
+        (vec!["--range", "2,1"], "--range"),
+        (vec!["--limit", "0"], "--limit"),
+    ] {
+        let mut all = vec!["render", "cube.obj", "-o", "out.png"];
+        all.extend(args);
+        assert_fails(d, &all, needle);
+    }
+    assert_fails(d, &["render", "cube.obj", "-o", "out.jpg"], ".png");
+    assert_fails(
+        d,
+        &["render", "missing.obj", "-o", "out.png"],
+        "missing.obj",
+    );
+    assert_fails(
+        d,
+        &[
+            "render", "cube.obj", "-o", "out.png", "--points", "nope.xyz",
+        ],
+        "nope.xyz",
+    );
+    assert_fails(
+        d,
+        &[
+            "render",
+            "cube.obj",
+            "-o",
+            "out.png",
+            "--color-by-distance-to",
+            "nope.obj",
+        ],
+        "nope.obj",
+    );
+    assert_fails(
+        d,
+        &["render", "cube.obj", "-o", "no/such/dir/out.png"],
+        "out.png",
+    );
+}
