@@ -1,0 +1,14 @@
+//! The built-in shapes: closed meshes with exact ground truth.
+
+mod anvil;
+mod bulb;
+mod catalog;
+mod genus2;
+mod implicit;
+mod marching_tets;
+mod quad_sphere;
+mod relax;
+mod revolve;
+mod sdf;
+
+pub use catalog::{ShapeKind, ShapeParams, build_shape, surface_deviation};
