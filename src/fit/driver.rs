@@ -95,6 +95,7 @@ pub fn fit_point_cloud(
         let kd = k.linear_combination(1.0, &d, 1.0)?;
         let mut p = mesh.positions.clone();
         let mut energy: Vec<Real> = Vec::new();
+        let (mut step_elapsed, mut step_rms_pct, mut step_p95_pct) = (Vec::new(), Vec::new(), Vec::new());
         let mut cg_iterations = 0;
         let mut steps = 0;
         let mut hints: Option<Vec<(u32, [Real; 2])>> = None;
@@ -120,6 +121,10 @@ pub fn fit_point_cloud(
                 (prev - e).abs() <= params.energy_tolerance * prev.abs()
             });
             energy.push(e);
+            let stats = ErrorStats::new(&dist, diameter);
+            step_elapsed.push(start.elapsed().as_secs_f64());
+            step_rms_pct.push(stats.rms_pct);
+            step_p95_pct.push(stats.p95_pct);
             if settled || steps >= params.max_steps {
                 break;
             }
@@ -150,6 +155,9 @@ pub fn fit_point_cloud(
             seconds: level_start.elapsed().as_secs_f64(),
             elapsed: start.elapsed().as_secs_f64(),
             energy,
+            step_elapsed,
+            step_rms_pct,
+            step_p95_pct,
             error,
             rejected: w.iter().filter(|&&w| w == 0.0).count() as Real / n,
         });

@@ -71,8 +71,14 @@ pub struct LevelReport {
     pub seconds: Real,
     /// Seconds since the fit started, at the end of this level.
     pub elapsed: Real,
-    /// Total energy after each step (data springs + stiffness).
+    /// Total energy before each step (data springs + stiffness).
     pub energy: Vec<Real>,
+    /// Seconds since the fit started, at each entry of `energy`.
+    pub step_elapsed: Vec<Real>,
+    /// RMS data-to-surface distance (% of the diameter) at each entry of `energy`.
+    pub step_rms_pct: Vec<Real>,
+    /// 95th-percentile distance (% of the diameter) at each entry of `energy`.
+    pub step_p95_pct: Vec<Real>,
     /// Distances from the data points to the surface at the end of the level.
     pub error: ErrorStats,
     /// Fraction of data points whose robust weight is zero (rejected outliers).

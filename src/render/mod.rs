@@ -32,6 +32,7 @@ mod font;
 mod legend;
 mod marks;
 mod picture;
+mod plot;
 mod raster;
 mod scene;
 mod shading;
@@ -43,6 +44,7 @@ pub use draw::render;
 pub use font::{draw_text, text_width};
 pub use legend::{nice_ticks, tick_labels};
 pub use picture::{MAX_SIDE, Picture, Rgb, check_png_path, write_png};
+pub use plot::{Series, line_plot, series_color};
 pub use scene::{
     BACK, CloudLayer, EDGES, MAX_WORK_PIXELS, MeshLayer, POINTS, RenderOptions, SURFACE, Scene,
 };
