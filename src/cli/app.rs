@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use super::{bench, common, compare, info, limit, render, subdivide};
+use super::{bench, common, compare, fit, info, limit, render, subdivide};
 
 /// subdyn: Catmull-Clark subdivision surfaces — refinement as stencil tables,
 /// exact limit evaluation, mesh inspection and benchmarks.
@@ -24,6 +24,8 @@ struct Cli {
 /// The verbs.
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Fit a dynamic Catmull-Clark surface to a point cloud (the embedded demo scan when no SCAN is given).
+    Fit(fit::FitArgs),
     /// Refine a mesh uniformly with Catmull-Clark (the embedded cube when no INPUT is given).
     Subdivide(subdivide::SubdivideArgs),
     /// Tessellate the limit surface: every quad face as a K×K grid of exact limit samples.
@@ -45,6 +47,7 @@ pub fn run() -> ExitCode {
     common::install_panic_hook();
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Fit(args) => fit::run(&args),
         Command::Subdivide(args) => subdivide::run(&args),
         Command::Limit(args) => limit::run(&args),
         Command::Info(args) => info::run(&args),

@@ -3,8 +3,10 @@
 mod app;
 mod bench;
 mod bench_closest;
+mod bench_distance;
 mod common;
 mod compare;
+mod fit;
 mod info;
 mod limit;
 mod mesh_stats;

@@ -95,7 +95,8 @@ pub fn fit_point_cloud(
         let kd = k.linear_combination(1.0, &d, 1.0)?;
         let mut p = mesh.positions.clone();
         let mut energy: Vec<Real> = Vec::new();
-        let (mut step_elapsed, mut step_rms_pct, mut step_p95_pct) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut step_elapsed, mut step_rms_pct, mut step_p95_pct) =
+            (Vec::new(), Vec::new(), Vec::new());
         let mut cg_iterations = 0;
         let mut steps = 0;
         let mut hints: Option<Vec<(u32, [Real; 2])>> = None;
@@ -176,7 +177,30 @@ pub fn fit_point_cloud(
                 format!("maximum level {level} reached above the tolerance"),
             );
         }
+        if let [.., before, last] = levels.as_slice()
+            && last.error.rms > (1.0 - params.min_level_gain) * before.error.rms
+        {
+            break (
+                false,
+                format!(
+                    "level {level} lowered the RMS error by less than {:.0} %: finer levels would fit the noise",
+                    100.0 * params.min_level_gain
+                ),
+            );
+        }
         let h = refiner.refine_uniform(1)?;
+        if h.level(1).num_vertices as Real > params.max_control_fraction * n {
+            break (
+                false,
+                format!(
+                    "level {} would have {} control points, more than {} × the {} data points",
+                    level + 1,
+                    h.level(1).num_vertices,
+                    params.max_control_fraction,
+                    points.len()
+                ),
+            );
+        }
         let p1 = h.stencil(0).apply(&mesh.positions)?;
         mesh = h.mesh(1, p1);
     };

@@ -29,16 +29,23 @@ pub struct FitParams {
     pub tolerance_stat: ToleranceStat,
     /// Subdivision levels allowed above the initial control mesh (default 3).
     pub max_level: usize,
-    /// Implicit steps per level at most (default 30).
+    /// Implicit steps per level at most (default 20).
     pub max_steps: usize,
     /// A level has settled when the energy changes by less than this fraction
-    /// between steps (default 1e-4).
+    /// between steps (default 1e-3).
     pub energy_tolerance: Real,
-    /// Tension weight `λ_t`: `α11 = α22 = λ_t / F` with `F` the number of
-    /// faces (default 1e-3).
+    /// Stop subdividing when a level lowers the RMS error by less than this
+    /// fraction (default 0.1): finer levels would fit the noise.
+    pub min_level_gain: Real,
+    /// Do not subdivide when the next level would have more control points
+    /// than this fraction of the data points (default 0.5).
+    pub max_control_fraction: Real,
+    /// Tension weight `λ_t`: `α11 = α22 = λ_t / A` with `A` the parameter
+    /// area (the number of faces; default 1e-5). Tension shrinks the surface,
+    /// so keep it small.
     pub tension: Real,
-    /// Bending weight `λ_b`: `β11 = β22 = λ_b / F`, `β12 = 2 λ_b / F`
-    /// (default 1e-3).
+    /// Bending weight `λ_b`: `β11 = β22 = λ_b / A`, `β12 = 2 λ_b / A`
+    /// (default 1e-4).
     pub bending: Real,
     /// Damping over the time step, `γ / Δt`, relative to the total data
     /// weight (default 0.05): the proximal term of the implicit step.
@@ -57,10 +64,12 @@ impl Default for FitParams {
             tolerance_pct: 0.1,
             tolerance_stat: ToleranceStat::P95,
             max_level: 3,
-            max_steps: 30,
-            energy_tolerance: 1e-4,
-            tension: 1e-3,
-            bending: 1e-3,
+            max_steps: 20,
+            energy_tolerance: 1e-3,
+            min_level_gain: 0.1,
+            max_control_fraction: 0.5,
+            tension: 1e-5,
+            bending: 1e-4,
             damping: 0.05,
             robust: RobustKernel::default(),
             patch_level: 2,
@@ -97,6 +106,8 @@ impl FitParams {
         }
         for (name, v) in [
             ("energy_tolerance", self.energy_tolerance),
+            ("min_level_gain", self.min_level_gain),
+            ("max_control_fraction", self.max_control_fraction),
             ("tension", self.tension),
             ("bending", self.bending),
             ("damping", self.damping),

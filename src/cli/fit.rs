@@ -1,0 +1,267 @@
+//! `subdyn fit [SCAN] [--init MESH|auto] [--tol PCT] [--max-level L] -o FIT.obj`:
+//! fit a dynamic Catmull-Clark surface to a point cloud (the main job).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use serde_json::json;
+
+use subdyn::fit::{FitParams, FitReport, ToleranceStat, fit_point_cloud};
+use subdyn::io::{read_points, write_mesh};
+use subdyn::limit::tessellate;
+use subdyn::mesh::{PointCloud, PolyMesh};
+use subdyn::subdivision::{RefineOptions, Refiner};
+
+use super::common::{
+    about_file, check_mesh_output, print_stdout, seconds, thousands, write_report,
+};
+use super::options::read_polygon_mesh;
+use super::progress::Progress;
+
+/// Which statistic `--tol` applies to.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum TolStat {
+    /// Largest distance (the paper's error).
+    Max,
+    /// 95th percentile.
+    P95,
+    /// Root mean square.
+    Rms,
+    /// Mean.
+    Mean,
+}
+
+/// Arguments of `subdyn fit`.
+#[derive(Debug, Args)]
+pub struct FitArgs {
+    /// Scan to fit (.ply, .xyz, .obj, .off; points, normals ignored). Without
+    /// it, the embedded demo scan is fitted.
+    #[arg(value_name = "SCAN")]
+    pub input: Option<PathBuf>,
+    /// Output control mesh; the format follows the extension.
+    #[arg(short, long, value_name = "FIT", default_value = "fit.obj")]
+    pub output: PathBuf,
+    /// Initial control mesh: a mesh file, or a method: `auto` (an open grid
+    /// for a single view, else the occupancy cage, or the principal-axes
+    /// ellipsoid cage when that finds genus 0), `closed` (the ellipsoid cage),
+    /// `open`, `occupancy`.
+    #[arg(long, value_name = "MESH|METHOD", default_value = "auto")]
+    pub init: String,
+    /// Tolerance in % of the scan's bounding-box diagonal.
+    #[arg(long, value_name = "PCT", default_value_t = 0.1)]
+    pub tol: f64,
+    /// Statistic the tolerance applies to.
+    #[arg(long, value_enum, default_value_t = TolStat::P95)]
+    pub tol_stat: TolStat,
+    /// Subdivision levels allowed above the initial mesh.
+    #[arg(long, value_name = "L", default_value_t = 3)]
+    pub max_level: usize,
+    /// Tension weight λ_t of the thin plate (α = λ_t / area).
+    #[arg(long, value_name = "λ", default_value_t = FitParams::default().tension)]
+    pub tension: f64,
+    /// Bending weight λ_b of the thin plate (β = λ_b / area).
+    #[arg(long, value_name = "λ", default_value_t = FitParams::default().bending)]
+    pub bending: f64,
+    /// Also write a dense limit-surface tessellation (K×K per quad, see --tess).
+    #[arg(long, value_name = "SURF")]
+    pub limit_out: Option<PathBuf>,
+    /// Tessellation rate of --limit-out.
+    #[arg(long, value_name = "K", default_value_t = 4)]
+    pub tess: usize,
+    /// Write a JSON report (per level: control points, time, CG iterations, errors).
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<PathBuf>,
+    /// Write a PNG plot of the error (95th percentile and RMS, % of the
+    /// diagonal) against time, one colour per level.
+    #[arg(long, value_name = "P.png")]
+    pub plot: Option<PathBuf>,
+    /// No progress display and no warnings.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Runs `subdyn fit`.
+pub fn run(args: &FitArgs) -> anyhow::Result<()> {
+    let start = Instant::now();
+    check_mesh_output(&args.output)?;
+    if let Some(p) = &args.limit_out {
+        check_mesh_output(p)?;
+    }
+    if let Some(p) = &args.plot {
+        subdyn::render::check_png_path(p)?;
+    }
+    if args.tess == 0 || args.tess > 64 {
+        anyhow::bail!("--tess {} is out of range: expected 1 to 64", args.tess);
+    }
+    let params = FitParams {
+        tolerance_pct: args.tol,
+        tolerance_stat: match args.tol_stat {
+            TolStat::Max => ToleranceStat::Max,
+            TolStat::P95 => ToleranceStat::P95,
+            TolStat::Rms => ToleranceStat::Rms,
+            TolStat::Mean => ToleranceStat::Mean,
+        },
+        max_level: args.max_level,
+        tension: args.tension,
+        bending: args.bending,
+        ..Default::default()
+    };
+    params.check()?;
+    let progress = Progress::new(args.quiet);
+    progress.stage("reading the scan");
+    let (cloud, name) = match &args.input {
+        Some(path) => (
+            read_points(path).map_err(|e| about_file(e, path))?,
+            path.display().to_string(),
+        ),
+        None => (
+            subdyn::examples::demo_scan()?,
+            "the embedded demo scan".to_string(),
+        ),
+    };
+    check_cloud(&cloud, &name)?;
+    progress.stage("building the initial model");
+    let (init, init_report) = initial_model(&args.init, &cloud, args.quiet)?;
+    let mut fit_progress = |level: usize, step: usize, energy: f64| {
+        progress.stage(format!("level {level}, step {step}: energy {energy:.4e}"));
+    };
+    let result = fit_point_cloud(&cloud, &init, &params, &mut fit_progress)
+        .map_err(|e| anyhow::Error::new(e).context(format!("fitting {name}")))?;
+    progress.stage(format!("writing {}", args.output.display()));
+    write_mesh(&args.output, &result.control, None).map_err(|e| about_file(e, &args.output))?;
+    if let Some(path) = &args.limit_out {
+        let refiner = Refiner::new(&result.control, &RefineOptions::default())?;
+        let (surf, normals) = tessellate(&refiner, &result.control.positions, args.tess)?;
+        write_mesh(path, &surf, Some(&normals)).map_err(|e| about_file(e, path))?;
+    }
+    if let Some(path) = &args.plot {
+        write_plot(path, &result.report)?;
+    }
+    drop(progress);
+    if let Some(path) = &args.report {
+        let value = json!({
+            "command": "fit",
+            "input": name,
+            "output": args.output.display().to_string(),
+            "limit_out": args.limit_out.as_ref().map(|p| p.display().to_string()),
+            "init": init_report,
+            "tolerance_pct": args.tol,
+            "tolerance_stat": format!("{:?}", args.tol_stat).to_lowercase(),
+            "fit": serde_json::to_value(&result.report)?,
+            "total_s": seconds(start),
+        });
+        write_report(path, &value)?;
+    }
+    print_stdout(&summary(
+        &name,
+        &args.output,
+        args.limit_out.as_deref(),
+        &result.report,
+    ))
+}
+
+/// Error against time, one colour per level (p95 solid markers, RMS as a
+/// second series per level).
+fn write_plot(path: &Path, report: &FitReport) -> anyhow::Result<()> {
+    use subdyn::render::{Series, line_plot, series_color, write_png};
+    let n = report.levels.len();
+    let mut series = Vec::new();
+    for (i, l) in report.levels.iter().enumerate() {
+        let pts = |v: &[f64]| -> Vec<(f64, f64)> {
+            l.step_elapsed
+                .iter()
+                .copied()
+                .zip(v.iter().map(|x| x.max(1e-9)))
+                .collect()
+        };
+        let c = series_color(i, n);
+        series.push(Series {
+            label: format!("L{} p95", l.level),
+            points: pts(&l.step_p95_pct),
+            color: c,
+        });
+        let light = [c[0] / 2 + 127, c[1] / 2 + 127, c[2] / 2 + 127];
+        series.push(Series {
+            label: format!("L{} RMS", l.level),
+            points: pts(&l.step_rms_pct),
+            color: light,
+        });
+    }
+    let pic = line_plot(
+        &series,
+        "seconds",
+        "distance, % of diagonal",
+        true,
+        800,
+        480,
+    )?;
+    write_png(path, &pic).map_err(|e| about_file(e, path))
+}
+
+fn check_cloud(cloud: &PointCloud, name: &str) -> anyhow::Result<()> {
+    if cloud.len() < 10 {
+        anyhow::bail!(
+            "{name}: {} points; a fit needs at least 10 points spread over the surface",
+            cloud.len()
+        );
+    }
+    Ok(())
+}
+
+/// The initial control mesh: a file, or `auto`.
+fn initial_model(
+    init: &str,
+    cloud: &PointCloud,
+    quiet: bool,
+) -> anyhow::Result<(PolyMesh, serde_json::Value)> {
+    if let Ok(kind) = init.parse::<subdyn::fit::init::InitKind>() {
+        let params = subdyn::fit::init::InitParams {
+            kind,
+            ..Default::default()
+        };
+        let (mesh, report) = subdyn::fit::init::initial_mesh(cloud, &params)?;
+        let value = json!({
+            "method": format!("{:?}", report.chosen).to_lowercase(),
+            "reason": report.reason,
+            "genus": report.genus,
+            "vertices": mesh.num_vertices(),
+            "faces": mesh.num_faces(),
+        });
+        return Ok((mesh, value));
+    }
+    let path = Path::new(init);
+    let mesh = read_polygon_mesh(path, quiet)?;
+    Refiner::new(&mesh, &RefineOptions::default()).map_err(|e| about_file(e, path))?;
+    let value = json!({"method": "file", "path": init, "vertices": mesh.num_vertices(), "faces": mesh.num_faces()});
+    Ok((mesh, value))
+}
+
+fn summary(name: &str, output: &Path, limit: Option<&Path>, r: &FitReport) -> String {
+    let mut s = format!(
+        "fitted {name} ({} points) in {:.2} s: {}\n",
+        thousands(r.points),
+        r.seconds,
+        r.stop_reason
+    );
+    s.push_str("level  control points  steps  CG its  seconds   max %   p95 %   RMS %  mean %\n");
+    for l in &r.levels {
+        s.push_str(&format!(
+            "{:>5}  {:>14}  {:>5}  {:>6}  {:>7.2}  {:>6.3}  {:>6.3}  {:>6.3}  {:>6.3}\n",
+            l.level,
+            thousands(l.control_points),
+            l.steps,
+            l.cg_iterations,
+            l.seconds,
+            l.error.max_pct,
+            l.error.p95_pct,
+            l.error.rms_pct,
+            l.error.mean_pct
+        ));
+    }
+    s.push_str(&format!("errors are data-to-surface distances in % of the scan's bounding-box diagonal\ncontrol mesh written to {}\n", output.display()));
+    if let Some(p) = limit {
+        s.push_str(&format!("limit surface written to {}\n", p.display()));
+    }
+    s
+}
