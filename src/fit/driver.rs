@@ -20,7 +20,9 @@ use crate::dynamics::{
     MaterialParams, PcgParams, damping_matrix, pcg, quadrature, stiffness_matrix,
 };
 use crate::error::{Error, Result};
-use crate::forces::{robust_weights, spring_system};
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+
+use crate::forces::{RobustKernel, robust_weights, row_springs, spring_system};
 use crate::limit::{ClosestPointEngine, ClosestPointParams, PatchTable};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
@@ -61,6 +63,9 @@ pub fn fit_point_cloud(
         ));
     }
     let start = Instant::now();
+    let data_tree: ImmutableKdTree<Real, 3> = ImmutableKdTree::new_from_slice(
+        &points.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+    );
     let mut mesh = init.clone();
     let mut levels = Vec::new();
     let n = points.len() as Real;
@@ -93,6 +98,18 @@ pub fn fit_point_cloud(
         let k = stiffness_matrix(&q, s, &material)?;
         let d = damping_matrix(&q, s, None, params.damping / area)?;
         let kd = k.linear_combination(1.0, &d, 1.0)?;
+        // Surface samples (the centre of every level-1 piece) for the
+        // surface-to-data springs.
+        let mut centres = crate::stencil::StencilTable::with_capacity(
+            qtable.to_level().num_rows(),
+            qtable.num_patches(),
+            0,
+        );
+        for f in 0..qtable.num_patches() {
+            let (cols, w) = qtable.position_stencil(f, [0.5, 0.5]);
+            centres.push_row(cols.into_iter().zip(w));
+        }
+        let centres = centres.compose(s)?;
         let mut p = mesh.positions.clone();
         let mut energy: Vec<Real> = Vec::new();
         let (mut step_elapsed, mut step_rms_pct, mut step_p95_pct) =
@@ -109,7 +126,32 @@ pub fn fit_point_cloud(
             let dist: Vec<Real> = closest.iter().map(|c| c.distance).collect();
             let w = robust_weights(&dist, params.robust, 1e-6 * diameter);
             let kw: Vec<Real> = w.iter().map(|w| w / n).collect();
-            let springs = spring_system(&engine, points, &closest, &kw)?;
+            let mut springs = spring_system(&engine, points, &closest, &kw)?;
+            if params.surface_weight > 0.0 {
+                // Surface-to-data springs: every surface sample to its
+                // nearest data point, so parts of the surface that no data
+                // point is closest to (bridges across gaps, flaps) are pulled
+                // onto the data too. Huber weights bound the pull.
+                let xs = centres.apply(&p)?;
+                let near: Vec<(Point3, Real)> = xs
+                    .iter()
+                    .map(|x| {
+                        let nn = data_tree.nearest_one::<SquaredEuclidean>(&[x.x, x.y, x.z]);
+                        (points[nn.item as usize], nn.distance.sqrt())
+                    })
+                    .collect();
+                let dd: Vec<Real> = near.iter().map(|n| n.1).collect();
+                let ws = robust_weights(&dd, RobustKernel::Huber(1.345), 1e-6 * diameter);
+                let m = xs.len() as Real;
+                let ks: Vec<Real> = ws.iter().map(|w| params.surface_weight * w / m).collect();
+                let targets: Vec<Point3> = near.iter().map(|n| n.0).collect();
+                let back = row_springs(&centres, &xs, &targets, &ks)?;
+                springs.matrix = springs.matrix.linear_combination(1.0, &back.matrix, 1.0)?;
+                for (r, b) in springs.rhs.iter_mut().zip(&back.rhs) {
+                    r.coords += b.coords;
+                }
+                springs.energy += back.energy;
+            }
             let kp = k.apply(&p)?;
             let e = springs.energy
                 + 0.5

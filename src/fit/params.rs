@@ -50,6 +50,10 @@ pub struct FitParams {
     /// Damping over the time step, `γ / Δt`, relative to the total data
     /// weight (default 0.05): the proximal term of the implicit step.
     pub damping: Real,
+    /// Weight of the surface-to-data springs (each surface sample pulled to
+    /// its nearest data point, Huber-weighted) relative to the data-to-surface
+    /// springs (default 0.5; 0 turns them off).
+    pub surface_weight: Real,
     /// Robust kernel of the data springs (default Tukey, 4.685 σ̂).
     pub robust: RobustKernel,
     /// Uniform level of the closest-point patches (default 2).
@@ -71,6 +75,7 @@ impl Default for FitParams {
             tension: 1e-5,
             bending: 1e-4,
             damping: 0.05,
+            surface_weight: 0.5,
             robust: RobustKernel::default(),
             patch_level: 2,
             quadrature_order: 4,
@@ -111,6 +116,7 @@ impl FitParams {
             ("tension", self.tension),
             ("bending", self.bending),
             ("damping", self.damping),
+            ("surface_weight", self.surface_weight),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(name, v, "must be finite and ≥ 0");

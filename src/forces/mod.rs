@@ -8,4 +8,4 @@ mod springs;
 
 pub use inflation::inflation_force;
 pub use robust::{RobustKernel, robust_weights};
-pub use springs::{SpringSystem, drag_spring, spring_system};
+pub use springs::{SpringSystem, drag_spring, row_springs, spring_system};

@@ -47,19 +47,44 @@ pub fn spring_system(
     let table = engine.table();
     let s = table.to_level();
     let mut rows = StencilTable::with_capacity(s.num_rows(), points.len(), 0);
-    let mut loads = Vec::with_capacity(points.len());
-    let mut energy = 0.0;
-    for ((d, c), &k) in points.iter().zip(closest).zip(k) {
-        if k == 0.0 {
-            continue;
-        }
-        let sk = k.sqrt();
+    for c in closest {
         let (cols, w) = table.position_stencil(c.patch.0 as usize, c.patch.1);
-        rows.push_row(cols.iter().zip(&w).map(|(&c, &w)| (c, sk * w)));
-        loads.push(Point3::from(sk * d.coords));
-        energy += 0.5 * k * (c.point - d).norm_squared();
+        rows.push_row(cols.into_iter().zip(w));
     }
-    let b = rows.compose(s)?;
+    let surface: Vec<Point3> = closest.iter().map(|c| c.point).collect();
+    row_springs(&rows.compose(s)?, &surface, points, k)
+}
+
+/// Springs from surface points `x_i = J_i p` (rows `j` over the control
+/// points, `x` their current positions) to targets `d_i` with stiffness `k_i`.
+pub fn row_springs(
+    j: &StencilTable,
+    x: &[Point3],
+    d: &[Point3],
+    k: &[Real],
+) -> Result<SpringSystem> {
+    if j.num_rows() != d.len() || x.len() != d.len() || k.len() != d.len() {
+        return Err(Error::Input(format!(
+            "springs: {} rows, {} surface points, {} targets, {} stiffnesses",
+            j.num_rows(),
+            x.len(),
+            d.len(),
+            k.len()
+        )));
+    }
+    let sk: Vec<Real> = k.iter().map(|k| k.sqrt()).collect();
+    let b = j.scale_rows(&sk)?;
+    let loads: Vec<Point3> = d
+        .iter()
+        .zip(&sk)
+        .map(|(d, &s)| Point3::from(s * d.coords))
+        .collect();
+    let energy = x
+        .iter()
+        .zip(d)
+        .zip(k)
+        .map(|((x, d), k)| 0.5 * k * (x - d).norm_squared())
+        .sum();
     Ok(SpringSystem {
         matrix: b.gram(),
         rhs: b.apply_transpose(&loads)?,
