@@ -40,10 +40,10 @@ fn quad_form(a: &StencilTable, x: &[Real]) -> Real {
 fn assert_symmetric(a: &StencilTable, what: &str) {
     let m = dense(a);
     let scale = m.iter().flatten().fold(0.0f64, |s, x| s.max(x.abs()));
-    for i in 0..m.len() {
-        for j in 0..i {
+    for (i, row) in m.iter().enumerate() {
+        for (j, &x) in row.iter().enumerate().take(i) {
             assert!(
-                (m[i][j] - m[j][i]).abs() <= 1e-13 * scale,
+                (x - m[j][i]).abs() <= 1e-13 * scale,
                 "{what} not symmetric at ({i}, {j})"
             );
         }
@@ -166,7 +166,13 @@ fn mass_matrix_is_spd_and_sums_to_mu_times_area() {
     // limit surface (limit mask 9/24 − 3·4/24 + 3·1/24 = 0), so it is in the
     // null space. One level finer the map to the limit surface is injective.
     let checker: Vec<Real> = (0..8)
-        .map(|i: u32| if i.count_ones().is_multiple_of(2) { 1.0 } else { -1.0 })
+        .map(|i: u32| {
+            if i.count_ones().is_multiple_of(2) {
+                1.0
+            } else {
+                -1.0
+            }
+        })
         .collect();
     assert!(quad_form(&m, &checker).abs() < 1e-12);
     for mesh in [

@@ -27,12 +27,20 @@ pub fn line_plot(
     width: u32,
     height: u32,
 ) -> Result<Picture> {
-    let pts: Vec<(Real, Real)> = series.iter().flat_map(|s| s.points.iter().copied()).collect();
+    let pts: Vec<(Real, Real)> = series
+        .iter()
+        .flat_map(|s| s.points.iter().copied())
+        .collect();
     if pts.is_empty() {
         return Err(Error::Input("nothing to plot".into()));
     }
-    if pts.iter().any(|p| !p.0.is_finite() || !p.1.is_finite() || (log_y && p.1 <= 0.0)) {
-        return Err(Error::Input("plot values must be finite (and positive on a log axis)".into()));
+    if pts
+        .iter()
+        .any(|p| !p.0.is_finite() || !p.1.is_finite() || (log_y && p.1 <= 0.0))
+    {
+        return Err(Error::Input(
+            "plot values must be finite (and positive on a log axis)".into(),
+        ));
     }
     let fy = |y: Real| if log_y { y.log10() } else { y };
     let (mut x0, mut x1) = (Real::INFINITY, Real::NEG_INFINITY);
@@ -54,7 +62,9 @@ pub fn line_plot(
     let mut pic = Picture::new(width, height, [255, 255, 255])?;
     let (left, right, top, bottom) = (70i64, width as i64 - 150, 20i64, height as i64 - 45);
     if right - left < 50 || bottom - top < 50 {
-        return Err(Error::Input(format!("plot size {width}×{height} is too small")));
+        return Err(Error::Input(format!(
+            "plot size {width}×{height} is too small"
+        )));
     }
     let sx = |x: Real| left + ((x - x0) / (x1 - x0) * (right - left) as Real).round() as i64;
     let sy = |y: Real| bottom - ((fy(y) - y0) / (y1 - y0) * (bottom - top) as Real).round() as i64;
@@ -65,10 +75,19 @@ pub fn line_plot(
     for (t, label) in xt.iter().zip(tick_labels(&xt)) {
         let x = sx(*t);
         line(&mut pic, (x, top), (x, bottom), grey);
-        draw_text(&mut pic, x - text_width(&label, 1) as i64 / 2, bottom + 6, &label, 1, black);
+        draw_text(
+            &mut pic,
+            x - text_width(&label, 1) as i64 / 2,
+            bottom + 6,
+            &label,
+            1,
+            black,
+        );
     }
     let yt: Vec<Real> = if log_y {
-        (y0.ceil() as i64..=y1.floor() as i64).map(|e| e as Real).collect()
+        (y0.ceil() as i64..=y1.floor() as i64)
+            .map(|e| e as Real)
+            .collect()
     } else {
         nice_ticks((y0, y1), 6)
     };
@@ -80,16 +99,35 @@ pub fn line_plot(
     for (t, label) in yt.iter().zip(ylabels) {
         let y = bottom - ((t - y0) / (y1 - y0) * (bottom - top) as Real).round() as i64;
         line(&mut pic, (left, y), (right, y), grey);
-        draw_text(&mut pic, left - 6 - text_width(&label, 1) as i64, y - 3, &label, 1, black);
+        draw_text(
+            &mut pic,
+            left - 6 - text_width(&label, 1) as i64,
+            y - 3,
+            &label,
+            1,
+            black,
+        );
     }
     line(&mut pic, (left, bottom), (right, bottom), black);
     line(&mut pic, (left, top), (left, bottom), black);
-    draw_text(&mut pic, (left + right) / 2 - text_width(x_label, 1) as i64 / 2, bottom + 22, x_label, 1, black);
+    draw_text(
+        &mut pic,
+        (left + right) / 2 - text_width(x_label, 1) as i64 / 2,
+        bottom + 22,
+        x_label,
+        1,
+        black,
+    );
     draw_text(&mut pic, 4, 4, y_label, 1, black);
     // Curves and key.
     for (k, s) in series.iter().enumerate() {
         for w in s.points.windows(2) {
-            line(&mut pic, (sx(w[0].0), sy(w[0].1)), (sx(w[1].0), sy(w[1].1)), s.color);
+            line(
+                &mut pic,
+                (sx(w[0].0), sy(w[0].1)),
+                (sx(w[1].0), sy(w[1].1)),
+                s.color,
+            );
         }
         for &(x, y) in &s.points {
             pic.fill_rect(sx(x) - 2, sy(y) - 2, sx(x) + 3, sy(y) + 3, s.color);
@@ -103,14 +141,21 @@ pub fn line_plot(
 
 /// Colour `i` of `n` distinct colours along the viridis map.
 pub fn series_color(i: usize, n: usize) -> Rgb {
-    ColorMap::Viridis.color(if n <= 1 { 0.0 } else { 0.85 * i as Real / (n - 1) as Real })
+    ColorMap::Viridis.color(if n <= 1 {
+        0.0
+    } else {
+        0.85 * i as Real / (n - 1) as Real
+    })
 }
 
 /// A one-pixel line (Bresenham 1965).
 fn line(pic: &mut Picture, a: (i64, i64), b: (i64, i64), color: Rgb) {
     let (mut x, mut y) = a;
     let (dx, dy) = ((b.0 - a.0).abs(), -(b.1 - a.1).abs());
-    let (sx, sy) = (if a.0 < b.0 { 1 } else { -1 }, if a.1 < b.1 { 1 } else { -1 });
+    let (sx, sy) = (
+        if a.0 < b.0 { 1 } else { -1 },
+        if a.1 < b.1 { 1 } else { -1 },
+    );
     let mut err = dx + dy;
     loop {
         pic.set(x, y, color);
