@@ -714,3 +714,75 @@ fn bench_closest_is_exact_and_prints_json_last_line() {
     let bad = subdyn(dir.path(), &["bench", "closest", "--queries", "0"]);
     assert_eq!(bad.status.code(), Some(1));
 }
+
+// ---------------------------------------------------------------- fit
+
+/// A sphere scan as an XYZ file (Fibonacci points, radius 1).
+fn sphere_xyz(n: usize) -> String {
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let (r, phi) = ((1.0 - z * z).sqrt(), 2.399_963_229_728_653 * i as f64);
+            format!("{} {} {}\n", r * phi.cos(), r * phi.sin(), z)
+        })
+        .collect()
+}
+
+#[test]
+fn fit_writes_mesh_report_and_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "sphere.xyz", sphere_xyz(1500).as_bytes());
+    let out = ok(&subdyn(
+        dir.path(),
+        &[
+            "fit",
+            "sphere.xyz",
+            "-o",
+            "fit.obj",
+            "--max-level",
+            "1",
+            "--report",
+            "r.json",
+            "--plot",
+            "p.png",
+            "--limit-out",
+            "s.ply",
+            "--quiet",
+        ],
+    ));
+    assert!(out.contains("fit.obj"), "{out}");
+    let report: Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("r.json")).unwrap()).unwrap();
+    let levels = report["fit"]["levels"].as_array().expect("levels");
+    assert!(!levels.is_empty());
+    let last = levels.last().unwrap();
+    assert!(last["error"]["p95_pct"].as_f64().unwrap() < 1.0, "{last}");
+    assert!(last["control_points"].as_u64().unwrap() > 0);
+    let fit = subdyn::io::read_mesh(dir.path().join("fit.obj")).unwrap();
+    assert!(fit.num_faces() > 0);
+    let png = std::fs::read(dir.path().join("p.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    assert!(dir.path().join("s.ply").exists());
+}
+
+#[test]
+fn fit_bad_inputs_are_one_line_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "three.xyz", b"0 0 0\n1 0 0\n0 1 0\n");
+    let out = subdyn(dir.path(), &["fit", "three.xyz", "-o", "fit.obj"]);
+    assert_clean_failure(dir.path(), &out, &["3 points"], &["three.xyz"]);
+    write(dir.path(), "nan.xyz", b"0 0 0\nnan 1 0\n0 1 0\n");
+    let out = subdyn(dir.path(), &["fit", "nan.xyz", "-o", "fit.obj"]);
+    assert_clean_failure(dir.path(), &out, &["nan.xyz"], &["nan.xyz", "three.xyz"]);
+    write(dir.path(), "sphere.xyz", sphere_xyz(200).as_bytes());
+    let out = subdyn(
+        dir.path(),
+        &["fit", "sphere.xyz", "-o", "fit.obj", "--tol=-1"],
+    );
+    assert_clean_failure(
+        dir.path(),
+        &out,
+        &["tol"],
+        &["nan.xyz", "sphere.xyz", "three.xyz"],
+    );
+}
