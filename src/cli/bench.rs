@@ -38,6 +38,9 @@ pub enum BenchCommand {
     /// Exact closest points on the limit surface against a tessellation +
     /// k-d tree baseline; the last stdout line is one JSON object.
     Closest(super::bench_closest::BenchClosestArgs),
+    /// Exact point-to-triangle-mesh distances (BVH) against brute force;
+    /// the last stdout line is one JSON object.
+    Distance(super::bench_distance::BenchDistanceArgs),
 }
 
 /// Arguments of `subdyn bench subdivide`.
@@ -65,6 +68,7 @@ pub fn run(cmd: &BenchCommand) -> anyhow::Result<()> {
     match cmd {
         BenchCommand::Subdivide(args) => bench_subdivide(args),
         BenchCommand::Closest(args) => super::bench_closest::bench_closest(args),
+        BenchCommand::Distance(args) => super::bench_distance::bench_distance(args),
     }
 }
 
