@@ -384,6 +384,8 @@ NOTES = [
     "The measured output is the limit tessellation `surf.ply` (4×4 exact limit samples per control quad); the "
     "exact-limit figures below each table measure `fit.obj` with `--limit-a` instead. Vertices column: control "
     "points of `fit.obj` / vertices of `surf.ply`.",
+    "OMP_WAIT_POLICY=PASSIVE is set for every method (Open3D and pymeshlab use OpenMP; with libgomp's default "
+    "busy-waiting, pymeshlab's screened Poisson took 36 s instead of 6 s on the loaded 2-core machine).",
     "Timings are single runs, wall clock on a shared 2-core machine; Open3D and pymeshlab use their own threading "
     "defaults, subdyn its own (rayon) — read them as orders of magnitude.",
 ]
@@ -401,6 +403,10 @@ def main() -> int:
     ap.add_argument("--out", default=str(HERE), help="where RESULTS.md and RESULTS.json go")
     args = ap.parse_args()
 
+    # OpenMP threads that busy-wait (libgomp's default) starve each other and
+    # the other processes on a small shared machine: pymeshlab's screened
+    # Poisson took 36 s instead of 6 s under load. Passive waiting for all.
+    os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
     ensure_venv(args)  # re-execs inside the venv when needed
     build_rust(args)
     for exe in (SUBDYN, DATA_GEN):
