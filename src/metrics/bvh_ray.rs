@@ -68,8 +68,10 @@ impl TriangleBvh {
             });
             let order = ascending(&t.map(|x| x as f32));
             for &i in &order {
-                // Never NaN: a slab test gives a finite entry or +∞.
-                if t[i] > t_best {
+                // Never NaN: a slab test gives a finite entry, or +∞ for a
+                // missed box. Missed boxes sort last and must stop the scan
+                // even while nothing has been hit (t_best = +∞).
+                if !t[i].is_finite() || t[i] > t_best {
                     break;
                 }
                 let first = n.child[i] as usize;
@@ -84,7 +86,7 @@ impl TriangleBvh {
                 }
             }
             for &i in order.iter().rev() {
-                if n.count[i] == 0 && n.child[i] != EMPTY && t[i] <= t_best {
+                if n.count[i] == 0 && n.child[i] != EMPTY && t[i].is_finite() && t[i] <= t_best {
                     stack_node[top] = n.child[i];
                     stack_t[top] = t[i];
                     top += 1;
