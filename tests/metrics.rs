@@ -278,6 +278,15 @@ fn degenerate_triangles_give_finite_answers() {
         p(2., 0., 0.),
     );
     assert!((x - p(1.5, 0.0, 0.0)).norm() < 1e-15 && w.iter().all(|v| v.is_finite()));
+    // Thousands of copies of one triangle (all centroids equal: median splits).
+    let tri = [p(0., 0., 0.), p(1., 0., 0.), p(0., 1., 0.)];
+    let copies = TriangleBvh::new(tri.to_vec(), vec![[0, 1, 2]; 5000]).unwrap();
+    let near = copies.closest_point(p(0.2, 0.2, 0.5)).unwrap();
+    assert_eq!(near.distance, 0.5);
+    let hit = copies
+        .ray_cast(p(0.2, 0.2, 0.5), -Vector3::z(), 1.0)
+        .unwrap();
+    assert_eq!(hit.t, 0.5);
 }
 
 #[test]

@@ -34,7 +34,8 @@ pub struct Hit {
     pub t: Real,
     /// Index of the triangle hit (see [`TriangleBvh::triangles`]).
     pub triangle: usize,
-    /// Barycentric coordinates of the hit in that triangle.
+    /// Barycentric coordinates of the hit in that triangle; they sum to 1
+    /// and each lies in `[−ε, 1 + ε]`, `ε =` [`RAY_BARY_SLACK`](super::RAY_BARY_SLACK).
     pub bary: [Real; 3],
 }
 

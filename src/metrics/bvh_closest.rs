@@ -9,7 +9,7 @@
 use crate::math::{Point3, Real};
 
 use super::bvh::{Nearest, STACK, TriangleBvh, ascending};
-use super::bvh_collapse::{EMPTY, Node4};
+use super::bvh_collapse::Node4;
 #[cfg(doc)]
 use super::triangle::PreparedTriangle;
 
@@ -70,7 +70,10 @@ impl TriangleBvh {
                 .sum::<Real>()
                 .sqrt();
             let mut bound = box_bound(best_d2, q_err);
+            // Children are pushed farthest first, leaves included, so the
+            // nearest box of all those pending is always the next one opened.
             let mut stack_node = [0u32; STACK];
+            let mut stack_count = [0u32; STACK];
             let mut stack_d2 = [0.0f32; STACK];
             let mut top = 1usize;
             while top > 0 {
@@ -78,27 +81,23 @@ impl TriangleBvh {
                 if stack_d2[top] >= bound {
                     continue;
                 }
-                let n = &self.nodes[stack_node[top] as usize];
-                let d2 = child_distances2(n, &q32);
-                let order = ascending(&d2);
-                // Leaves now, nearest first (each may lower the bound) ...
-                for &i in &order {
-                    if d2[i] >= bound {
-                        break;
-                    }
-                    let first = n.child[i] as usize;
+                let (child, count) = (stack_node[top] as usize, stack_count[top] as usize);
+                if count > 0 {
                     let before = best_d2;
-                    for slot in first..first + n.count[i] as usize {
+                    for slot in child..child + count {
                         visit(slot, &mut best_d2);
                     }
                     if best_d2 < before {
                         bound = box_bound(best_d2, q_err);
                     }
+                    continue;
                 }
-                // ... inner children onto the stack, nearest on top.
-                for &i in order.iter().rev() {
-                    if n.count[i] == 0 && n.child[i] != EMPTY && d2[i] < bound {
+                let n = &self.nodes[child];
+                let d2 = child_distances2(n, &q32);
+                for &i in ascending(&d2).iter().rev() {
+                    if d2[i] < bound {
                         stack_node[top] = n.child[i];
+                        stack_count[top] = n.count[i];
                         stack_d2[top] = d2[i];
                         top += 1;
                     }
@@ -139,8 +138,8 @@ fn box_bound(best_d2: Real, q_err: Real) -> f32 {
 
 /// Squared distances from `q` (relative to the tree's origin, rounded to
 /// `f32`) to the four child boxes of `n`, in `f32`, four lanes at a time
-/// (infinite for an empty slot). Plain comparisons, not `f32::max` (whose
-/// NaN rule costs instructions): the inputs are never NaN.
+/// (infinite for an empty slot, so it is never pushed). Plain comparisons,
+/// not `f32::max` (whose NaN rule costs instructions): inputs are never NaN.
 #[inline]
 #[allow(clippy::needless_range_loop)] // lane loops over `[axis][child]` arrays vectorise
 fn child_distances2(n: &Node4, q: &[f32; 3]) -> [f32; 4] {
