@@ -63,6 +63,17 @@ pub struct BenchSubdivideArgs {
     pub quiet: bool,
 }
 
+/// Sets the number of worker threads of a benchmark (`None`: all cores).
+pub fn set_threads(threads: Option<usize>) -> anyhow::Result<()> {
+    if let Some(t) = threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build_global()
+            .map_err(|e| anyhow::anyhow!("cannot start {t} threads: {e}"))?;
+    }
+    Ok(())
+}
+
 /// Runs a benchmark.
 pub fn run(cmd: &BenchCommand) -> anyhow::Result<()> {
     match cmd {
@@ -108,12 +119,7 @@ fn bench_subdivide(args: &BenchSubdivideArgs) -> anyhow::Result<()> {
     if args.repeat == 0 {
         anyhow::bail!("--repeat must be at least 1");
     }
-    if let Some(t) = args.threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build_global()
-            .map_err(|e| anyhow::anyhow!("cannot start {t} threads: {e}"))?;
-    }
+    set_threads(args.threads)?;
     let progress = Progress::new(args.quiet);
     let t = measure(args, &progress)?;
     drop(progress);

@@ -17,6 +17,7 @@ use subdyn::math::{Point3, bbox_diagonal};
 use subdyn::mesh::PolyMesh;
 use subdyn::subdivision::{RefineOptions, Refiner};
 
+use super::bench::set_threads;
 use super::common::{print_stdout, thousands, timed};
 use super::options::read_polygon_mesh;
 use super::progress::Progress;
@@ -63,12 +64,7 @@ pub fn bench_closest(args: &BenchClosestArgs) -> anyhow::Result<()> {
             args.baseline_tess
         );
     }
-    if let Some(t) = args.threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build_global()
-            .map_err(|e| anyhow::anyhow!("cannot start {t} threads: {e}"))?;
-    }
+    set_threads(args.threads)?;
     let (mesh, name) = match &args.input {
         Some(path) => (
             read_polygon_mesh(path, args.quiet)?,

@@ -20,6 +20,7 @@ use subdyn::math::{Point3, Real, bbox_diagonal, bounding_box};
 use subdyn::mesh::PolyMesh;
 use subdyn::metrics::{TriangleBvh, area_samples, closest_point_on_triangle, distances};
 
+use super::bench::set_threads;
 use super::common::{print_stdout, thousands, timed};
 use super::progress::Progress;
 
@@ -75,12 +76,7 @@ pub fn bench_distance(args: &BenchDistanceArgs) -> anyhow::Result<()> {
     {
         anyhow::bail!("--near {f} is out of range: expected 0 ≤ F < 1");
     }
-    if let Some(t) = args.threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build_global()
-            .map_err(|e| anyhow::anyhow!("cannot start {t} threads: {e}"))?;
-    }
+    set_threads(args.threads)?;
     let progress = Progress::new(args.quiet);
     progress.stage("making the torus and the points");
     // Quads n × m with n ≈ 3m (the ratio of the two circumferences), 2nm ≈ M.
