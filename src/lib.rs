@@ -38,5 +38,6 @@ pub mod render;
 pub mod stencil;
 pub mod subdivision;
 pub mod topology;
+pub mod volume;
 
 pub use error::{Error, Result};
