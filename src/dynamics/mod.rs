@@ -9,4 +9,4 @@ mod quadrature;
 
 pub use matrices::{MaterialParams, damping_matrix, mass_matrix, stiffness_matrix};
 pub use pcg::{PcgParams, PcgReport, pcg};
-pub use quadrature::{Quadrature, gauss_legendre, quadrature};
+pub use quadrature::{Quadrature, gauss_legendre, patch_samples, quadrature};

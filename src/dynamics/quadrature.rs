@@ -66,6 +66,20 @@ pub fn gauss_legendre(n: usize) -> Vec<(Real, Real)> {
 /// `order × order` Gauss-Legendre points on every polynomial piece of every
 /// patch of `table`.
 pub fn quadrature(table: &PatchTable, order: usize) -> Result<Quadrature> {
+    quadrature_on(table, order, true)
+}
+
+/// `order × order` Gauss-Legendre points on every patch of `table` as a
+/// whole: exact on regular patches like [`quadrature`], approximate on the
+/// patches at irregular vertices, which it samples with the same density as
+/// the others instead of refining towards the vertex — the sample set for
+/// forces (image forces, surface springs), where [`quadrature`]'s deep
+/// quadtrees would multiply the work for a vanishing area.
+pub fn patch_samples(table: &PatchTable, order: usize) -> Result<Quadrature> {
+    quadrature_on(table, order, false)
+}
+
+fn quadrature_on(table: &PatchTable, order: usize, per_piece: bool) -> Result<Quadrature> {
     if order == 0 || order > 16 {
         return Err(Error::Input(format!(
             "quadrature order {order} must be between 1 and 16"
@@ -79,7 +93,12 @@ pub fn quadrature(table: &PatchTable, order: usize) -> Result<Quadrature> {
             let det_axes = (axes[0][0] * axes[1][1] - axes[0][1] * axes[1][0]).abs();
             let inv_axes = invert(axes);
             let mut out = Vec::new();
-            for (jac, off) in table.cells(f) {
+            let cells = if per_piece {
+                table.cells(f)
+            } else {
+                vec![([[1.0, 0.0], [0.0, 1.0]], [0.0, 0.0])]
+            };
+            for (jac, off) in cells {
                 let inv = invert(jac);
                 let det_inv = (inv[0][0] * inv[1][1] - inv[0][1] * inv[1][0]).abs();
                 for &(a, wa) in &gl {

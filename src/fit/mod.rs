@@ -6,6 +6,7 @@
 mod driver;
 pub mod init;
 mod params;
+pub mod recover;
 mod report;
 
 pub use driver::{FitResult, fit_point_cloud};

@@ -153,6 +153,12 @@ impl Volume {
         [v.x, v.y, v.z]
     }
 
+    /// A world-space vector in index units (`L⁻¹ v`).
+    pub fn index_vector(&self, v: &Vector3) -> [Real; 3] {
+        let c = self.inverse * v;
+        [c.x, c.y, c.z]
+    }
+
     /// Whether a world position lies inside the grid's sample box
     /// (`0 ≤ index ≤ n − 1` on every axis).
     pub fn contains(&self, p: &Point3) -> bool {

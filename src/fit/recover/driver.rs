@@ -1,0 +1,343 @@
+//! The multilevel volume-recovery driver (Qin, Mandal, Vemuri 1998, §4.2
+//! and §6, the cerebellum and caudate experiments).
+//!
+//! [`prepare_volume`] smooths the volume (`G_σ * I`), computes the edge
+//! potential when edges are wanted, and fixes the intensity that separates
+//! inside from outside (the iso-value, or Otsu's threshold). [`recover_shape`]
+//! then evolves the control points with the first-order dynamics of the
+//! point-cloud fit, `(γ/Δt · D + K + Σ k JᵀJ) p⁺ = γ/Δt · D p + Σ k Jᵀ y`, the
+//! targets `y = x + t n` being the image boundary found along the normal of
+//! every quadrature point (see [`crate::forces::ImageField`]), with stiffness
+//! `k` proportional to the point's area. A level ends when the energy
+//! settles; if the 95th percentile of `|t|` is above the tolerance the
+//! control mesh is subdivided and the evolution goes on.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use super::{RecoverLevel, RecoverParams, RecoverReport};
+use crate::dynamics::{
+    MaterialParams, PcgParams, damping_matrix, patch_samples, pcg, quadrature, stiffness_matrix,
+};
+use crate::error::{Error, Result};
+use crate::fit::ErrorStats;
+use crate::forces::{BoundaryModel, ImageField, Offset, inflation_force, row_springs};
+use crate::limit::PatchTable;
+use crate::math::{Point3, Real, bbox_diagonal};
+use crate::mesh::PolyMesh;
+use crate::subdivision::{RefineOptions, Refiner};
+use crate::volume::{Volume, edge_potential, gaussian_smoothed, otsu_threshold};
+
+/// A volume ready for recovery: smoothed, with its edge potential.
+#[derive(Clone, Debug)]
+pub struct PreparedVolume {
+    /// `G_σ * I`.
+    pub smoothed: Volume,
+    /// The edge potential (for [`BoundaryModel::Edge`]).
+    pub potential: Option<Volume>,
+    /// Intensity separating inside from outside: the iso-value, or Otsu's
+    /// threshold of the smoothed volume.
+    pub inside_level: Real,
+    /// σ used, world units.
+    pub sigma: Real,
+    /// Seconds spent smoothing.
+    pub smoothing_seconds: Real,
+    /// Seconds spent on the potential.
+    pub potential_seconds: Real,
+}
+
+/// The precompute step: smoothing, edge potential and inside level.
+/// Errors for a constant volume.
+pub fn prepare_volume(volume: &Volume, params: &RecoverParams) -> Result<PreparedVolume> {
+    params.check()?;
+    let (lo, hi) = volume.range();
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
+        return Err(Error::Input(format!(
+            "the volume is constant ({lo}): there is no boundary to recover"
+        )));
+    }
+    let sigma = params.sigma.unwrap_or(volume.voxel_size());
+    let t = Instant::now();
+    let smoothed = gaussian_smoothed(volume, sigma)?;
+    let smoothing_seconds = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let (potential, inside_level) = match params.boundary {
+        BoundaryModel::Iso { value } => {
+            if !(value > lo as Real && value < hi as Real) {
+                return Err(Error::Input(format!(
+                    "iso-value {value} lies outside the volume's range [{lo}, {hi}]"
+                )));
+            }
+            (None, value)
+        }
+        BoundaryModel::Edge { .. } => (
+            Some(edge_potential(&smoothed)?),
+            otsu_threshold(&smoothed)? as Real,
+        ),
+    };
+    Ok(PreparedVolume {
+        smoothed,
+        potential,
+        inside_level,
+        sigma,
+        smoothing_seconds,
+        potential_seconds: t.elapsed().as_secs_f64(),
+    })
+}
+
+/// A recovered shape and what it took.
+#[derive(Clone, Debug)]
+pub struct RecoverResult {
+    /// The control mesh of the finest level reached.
+    pub control: PolyMesh,
+    /// The report.
+    pub report: RecoverReport,
+}
+
+/// The solve step: evolves `init` (a closed, outward-oriented control mesh
+/// inside or around the object) to the boundary in `prepared`.
+/// `progress(level, step, energy)` is called after every step.
+pub fn recover_shape(
+    prepared: &PreparedVolume,
+    init: &PolyMesh,
+    params: &RecoverParams,
+    progress: &mut dyn FnMut(usize, usize, Real),
+) -> Result<RecoverResult> {
+    params.check()?;
+    crate::mesh::check_finite(&init.positions)?;
+    let start = Instant::now();
+    let field = ImageField {
+        smoothed: &prepared.smoothed,
+        potential: prepared.potential.as_ref(),
+        model: params.boundary,
+        inside_level: prepared.inside_level,
+        bright_inside: params.bright_inside,
+    };
+    let voxel = prepared.smoothed.voxel_size();
+    let mut mesh = init.clone();
+    let mut levels: Vec<RecoverLevel> = Vec::new();
+    let (converged, stop_reason) = loop {
+        let level = levels.len();
+        let level_start = Instant::now();
+        let refiner = Refiner::new(&mesh, &RefineOptions::default())?;
+        if (0..refiner.level.num_edges()).any(|e| refiner.level.is_boundary_edge(e)) {
+            return Err(Error::Topology(
+                "the initial mesh has a boundary: recovering a volume needs a closed surface"
+                    .into(),
+            ));
+        }
+        let qtable = PatchTable::new(&refiner, &mesh.positions, 1)?;
+        let q = quadrature(&qtable, params.quadrature_order)?;
+        let s = qtable.to_level();
+        // Image samples: Gauss points per level-1 patch (not per quadtree
+        // leaf, which would crowd them at irregular vertices).
+        let fs = patch_samples(&qtable, params.quadrature_order)?;
+        let j = fs.rows.p.compose(s)?;
+        let ju = fs.rows.du.compose(s)?;
+        let jv = fs.rows.dv.compose(s)?;
+        let area: Real = q.weights.iter().sum();
+        let material = MaterialParams {
+            alpha11: params.tension / area,
+            alpha22: params.tension / area,
+            beta11: params.bending / area,
+            beta12: 2.0 * params.bending / area,
+            beta22: params.bending / area,
+            ..Default::default()
+        };
+        let k = stiffness_matrix(&q, s, &material)?;
+        let d = damping_matrix(&q, s, None, params.damping / area)?;
+        let kd = k.linear_combination(1.0, &d, 1.0)?;
+        let sample_step = 0.25 * voxel;
+        let search_of = |p: &[Point3]| {
+            params
+                .search_voxels
+                .unwrap_or((mean_edge_length(&mesh, p) / voxel / 3.0).clamp(2.0, 12.0))
+        };
+        let max_steps = if level == 0 {
+            4 * params.max_steps
+        } else {
+            params.max_steps
+        };
+        let mut p = mesh.positions.clone();
+        let mut energy: Vec<Real> = Vec::new();
+        let (mut steps, mut cg_iterations, mut still) = (0, 0, false);
+        let (offsets, unresolved, search) = loop {
+            let search = search_of(&p);
+            let range = search * voxel;
+            let xs = j.apply(&p)?;
+            let us = ju.apply(&p)?;
+            let vs = jv.apply(&p)?;
+            let found: Vec<(Point3, Real, Offset)> = (0..xs.len())
+                .into_par_iter()
+                .map(|i| {
+                    let nrm = us[i].coords.cross(&vs[i].coords);
+                    let da = nrm.norm();
+                    if da.is_nan() || da <= 0.0 {
+                        return (xs[i], 0.0, Offset::Boundary(0.0));
+                    }
+                    let n = nrm / da;
+                    let o = field.boundary_offset(&xs[i], &n, range, sample_step);
+                    let t = match o {
+                        Offset::Boundary(t) => t,
+                        Offset::Inside => range,
+                        Offset::Outside => -range,
+                    };
+                    (xs[i] + t * n, da * fs.weights[i], o)
+                })
+                .collect();
+            let total: Real = found.iter().map(|f| f.1).sum();
+            if total.is_nan() || total <= 0.0 {
+                return Err(Error::Input(
+                    "the model's limit surface has no area; is the initial mesh degenerate?".into(),
+                ));
+            }
+            let targets: Vec<Point3> = found.iter().map(|f| f.0).collect();
+            let kw: Vec<Real> = found.iter().map(|f| f.1 / total).collect();
+            let springs = row_springs(&j, &xs, &targets, &kw)?;
+            let kp = k.apply(&p)?;
+            let e = springs.energy
+                + 0.5
+                    * kp.iter()
+                        .zip(&p)
+                        .map(|(a, b)| a.coords.dot(&b.coords))
+                        .sum::<Real>();
+            progress(level, steps, e);
+            let unresolved_area: Real = found
+                .iter()
+                .filter(|f| !matches!(f.2, Offset::Boundary(_)))
+                .map(|f| f.1)
+                .sum::<Real>()
+                / total;
+            // While points still search for the boundary (growing from a
+            // seed), the energy stays flat without being settled.
+            let settled = unresolved_area < 0.01
+                && (still
+                    || energy.last().is_some_and(|&prev: &Real| {
+                        (prev - e).abs() <= params.energy_tolerance * prev.abs()
+                    }));
+            energy.push(e);
+            if settled || steps >= max_steps {
+                let t: Vec<Real> = found
+                    .iter()
+                    .filter_map(|f| match f.2 {
+                        Offset::Boundary(t) => Some(t.abs() / voxel),
+                        _ => None,
+                    })
+                    .collect();
+                let unresolved = 1.0 - t.len() as Real / found.len() as Real;
+                break (
+                    ErrorStats::new(&t, bbox_diagonal(&xs) / voxel),
+                    unresolved,
+                    search,
+                );
+            }
+            let a = kd.linear_combination(1.0, &springs.matrix, 1.0)?;
+            let dp = d.apply(&p)?;
+            let mut rhs: Vec<Point3> = springs
+                .rhs
+                .iter()
+                .zip(&dp)
+                .map(|(a, b)| Point3::from(a.coords + b.coords))
+                .collect();
+            if params.inflation != 0.0 {
+                let level_p = s.apply(&p)?;
+                let f = inflation_force(&q, s, &level_p, params.inflation * voxel / total)?;
+                for (r, f) in rhs.iter_mut().zip(&f) {
+                    r.coords += f.coords;
+                }
+            }
+            let before = p.clone();
+            let report = pcg(&a, &rhs, &mut p, &PcgParams::default())?;
+            cg_iterations += report.iterations;
+            steps += 1;
+            let moved = before
+                .iter()
+                .zip(&p)
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, Real::max);
+            still = moved < 0.01 * voxel;
+        };
+        mesh.positions = p;
+        levels.push(RecoverLevel {
+            level,
+            control_points: mesh.num_vertices(),
+            faces: mesh.num_faces(),
+            samples: fs.weights.len(),
+            steps,
+            cg_iterations,
+            seconds: level_start.elapsed().as_secs_f64(),
+            energy,
+            offsets,
+            unresolved,
+            search_voxels: search,
+        });
+        if offsets.p95 <= params.tolerance_voxels && unresolved < 0.01 {
+            break (true, format!("tolerance met at level {level}"));
+        }
+        if level >= params.max_level {
+            break (
+                false,
+                format!("maximum level {level} reached above the tolerance"),
+            );
+        }
+        if let [.., before, last] = levels.as_slice()
+            && last.offsets.rms > (1.0 - params.min_level_gain) * before.offsets.rms
+            && last.unresolved < 0.01
+        {
+            break (
+                false,
+                format!(
+                    "level {level} lowered the RMS offset by less than {:.0} %: finer levels would follow the noise",
+                    100.0 * params.min_level_gain
+                ),
+            );
+        }
+        let edge = mean_edge_length(&mesh, &mesh.positions);
+        if 0.5 * edge < params.min_edge_voxels * voxel {
+            break (
+                false,
+                format!(
+                    "level {} would have control edges of {:.2} voxels, below the {} voxel minimum",
+                    level + 1,
+                    0.5 * edge / voxel,
+                    params.min_edge_voxels
+                ),
+            );
+        }
+        let h = refiner.refine_uniform(1)?;
+        let p1 = h.stencil(0).apply(&mesh.positions)?;
+        mesh = h.mesh(1, p1);
+    };
+    Ok(RecoverResult {
+        control: mesh,
+        report: RecoverReport {
+            voxel,
+            sigma: prepared.sigma,
+            inside_level: prepared.inside_level,
+            smoothing_seconds: prepared.smoothing_seconds,
+            potential_seconds: prepared.potential_seconds,
+            levels,
+            converged,
+            stop_reason,
+            seconds: start.elapsed().as_secs_f64()
+                + prepared.smoothing_seconds
+                + prepared.potential_seconds,
+        },
+    })
+}
+
+/// Mean length of the control mesh's edges at positions `p` (each face side
+/// counted once per face).
+fn mean_edge_length(mesh: &PolyMesh, p: &[Point3]) -> Real {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for f in 0..mesh.num_faces() {
+        let face = mesh.face(f);
+        for (i, &a) in face.iter().enumerate() {
+            let b = face[(i + 1) % face.len()];
+            sum += (p[a as usize] - p[b as usize]).norm();
+            n += 1;
+        }
+    }
+    sum / n.max(1) as Real
+}

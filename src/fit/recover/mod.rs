@@ -1,0 +1,13 @@
+//! Recovering shapes from volumes (MRI, CT, slice stacks): the dynamic
+//! surface pulled by image forces, multilevel as for scans (Qin, Mandal,
+//! Vemuri 1998, §4.2 and §6).
+
+mod driver;
+mod init;
+mod params;
+mod report;
+
+pub use driver::{PreparedVolume, RecoverResult, prepare_volume, recover_shape};
+pub use init::{ComponentCage, component_cage, seed_cage};
+pub use params::RecoverParams;
+pub use report::{RecoverLevel, RecoverReport};

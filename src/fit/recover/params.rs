@@ -1,0 +1,144 @@
+//! Parameters of [`recover_shape`](super::recover_shape).
+
+use crate::error::{Error, Result};
+use crate::forces::BoundaryModel;
+use crate::math::Real;
+
+/// Options of the volume recovery. Lengths in voxels are multiples of the
+/// volume's smallest spacing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecoverParams {
+    /// What marks the boundary (default: the edge potential with
+    /// `min_strength` 0.1; use [`BoundaryModel::Iso`] when the iso-value is known).
+    pub boundary: BoundaryModel,
+    /// Gaussian smoothing σ in world units before edges are taken (default
+    /// `None`: one voxel).
+    pub sigma: Option<Real>,
+    /// The object is brighter than its surroundings (default true).
+    pub bright_inside: bool,
+    /// Stop when the 95th percentile of the surface-to-boundary offsets is
+    /// at or below this many voxels (default 0.5).
+    pub tolerance_voxels: Real,
+    /// Subdivision levels allowed above the initial cage (default 3).
+    pub max_level: usize,
+    /// Implicit steps per level at most (default 60; the level the seed
+    /// grows at gets four times as many).
+    pub max_steps: usize,
+    /// A level has settled when the energy changes by less than this fraction
+    /// between steps (default 1e-3) or no control point moves by more than
+    /// 1 % of a voxel.
+    pub energy_tolerance: Real,
+    /// Stop subdividing when a level lowers the RMS offset by less than this
+    /// fraction (default 0.1).
+    pub min_level_gain: Real,
+    /// Do not subdivide when the mean control edge would be shorter than this
+    /// many voxels (default 2).
+    pub min_edge_voxels: Real,
+    /// Half-length of the search along each normal, in voxels (default
+    /// `None`: a third of the mean control edge, clamped to 2 ..= 12 voxels).
+    pub search_voxels: Option<Real>,
+    /// Tension weight `λ_t` (as in [`FitParams`](crate::fit::FitParams); default 1e-5).
+    pub tension: Real,
+    /// Bending weight `λ_b` (default 1e-4).
+    pub bending: Real,
+    /// Damping over the time step relative to the image springs (default 0.05).
+    pub damping: Real,
+    /// Extra inflation pressure along the normal, relative to the image
+    /// springs per unit area and in voxels (default 0; the search already
+    /// pushes points with no boundary in range outward when they are inside).
+    pub inflation: Real,
+    /// Gauss-Legendre points per side of every level-1 piece (default 3).
+    pub quadrature_order: usize,
+}
+
+impl Default for RecoverParams {
+    fn default() -> Self {
+        RecoverParams {
+            boundary: BoundaryModel::Edge { min_strength: 0.1 },
+            sigma: None,
+            bright_inside: true,
+            tolerance_voxels: 0.5,
+            max_level: 3,
+            max_steps: 60,
+            energy_tolerance: 1e-3,
+            min_level_gain: 0.1,
+            min_edge_voxels: 2.0,
+            search_voxels: None,
+            tension: 1e-5,
+            bending: 1e-4,
+            damping: 0.05,
+            inflation: 0.0,
+            quadrature_order: 3,
+        }
+    }
+}
+
+impl RecoverParams {
+    /// Checks every value; the error names the parameter.
+    pub fn check(&self) -> Result<()> {
+        let positive = |name: &str, v: Real| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(Error::Input(format!(
+                    "{name} {v} must be a positive number"
+                )))
+            }
+        };
+        let non_negative = |name: &str, v: Real| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(Error::Input(format!(
+                    "{name} {v} must be a finite number ≥ 0"
+                )))
+            }
+        };
+        match self.boundary {
+            BoundaryModel::Iso { value } if !value.is_finite() => {
+                return Err(Error::Input(format!("iso-value {value} is not finite")));
+            }
+            BoundaryModel::Edge { min_strength } if !(0.0..1.0).contains(&min_strength) => {
+                return Err(Error::Input(format!(
+                    "edge strength {min_strength} must be in [0, 1)"
+                )));
+            }
+            _ => {}
+        }
+        if let Some(s) = self.sigma {
+            non_negative("sigma", s)?;
+        }
+        positive("tolerance", self.tolerance_voxels)?;
+        if self.max_level > 6 {
+            return Err(Error::Input(format!(
+                "max level {} is absurd: each level has four times the faces; at most 6",
+                self.max_level
+            )));
+        }
+        if self.max_steps == 0 || self.max_steps > 100_000 {
+            return Err(Error::Input(format!(
+                "max steps {} must be between 1 and 100000",
+                self.max_steps
+            )));
+        }
+        positive("energy tolerance", self.energy_tolerance)?;
+        non_negative("min level gain", self.min_level_gain)?;
+        positive("min edge", self.min_edge_voxels)?;
+        if let Some(s) = self.search_voxels {
+            positive("search range", s)?;
+        }
+        non_negative("tension", self.tension)?;
+        non_negative("bending", self.bending)?;
+        positive("damping", self.damping)?;
+        if !self.inflation.is_finite() {
+            return Err(Error::Input("inflation must be finite".into()));
+        }
+        if !(1..=8).contains(&self.quadrature_order) {
+            return Err(Error::Input(format!(
+                "quadrature order {} must be between 1 and 8",
+                self.quadrature_order
+            )));
+        }
+        Ok(())
+    }
+}

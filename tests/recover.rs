@@ -1,0 +1,98 @@
+//! Recovering shapes from volumes: analytic volumes with known surfaces.
+
+use subdyn::fit::recover::{
+    RecoverParams, component_cage, prepare_volume, recover_shape, seed_cage,
+};
+use subdyn::forces::BoundaryModel;
+use subdyn::limit::tessellate;
+use subdyn::math::{Point3, Real};
+use subdyn::subdivision::{RefineOptions, Refiner};
+use subdyn::volume::Volume;
+
+/// A volume of `dims` voxels, spacing `spacing`, whose value at a voxel centre
+/// is `clamp(0.5 − sdf / w, 0, 1)` for a signed distance `sdf` (negative
+/// inside) and a ramp of width `w` (world units): the 0.5 level is the surface.
+fn sdf_volume(dims: [usize; 3], spacing: [Real; 3], sdf: impl Fn(Point3) -> Real) -> Volume {
+    let w = spacing.iter().cloned().fold(0.0, Real::max);
+    let mut data = Vec::with_capacity(dims.iter().product());
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                let p = Point3::new(
+                    i as Real * spacing[0],
+                    j as Real * spacing[1],
+                    k as Real * spacing[2],
+                );
+                data.push((0.5 - sdf(p) / w).clamp(0.0, 1.0) as f32);
+            }
+        }
+    }
+    Volume::new(dims, data, spacing, Point3::origin()).unwrap()
+}
+
+/// Largest and mean |sdf| over a dense limit tessellation of `control`.
+fn surface_error(control: &subdyn::mesh::PolyMesh, sdf: impl Fn(Point3) -> Real) -> (Real, Real) {
+    let refiner = Refiner::new(control, &RefineOptions::default()).unwrap();
+    let (tess, _) = tessellate(&refiner, &control.positions, 4).unwrap();
+    let d: Vec<Real> = tess.positions.iter().map(|p| sdf(*p).abs()).collect();
+    let max = d.iter().cloned().fold(0.0, Real::max);
+    (max, d.iter().sum::<Real>() / d.len() as Real)
+}
+
+#[test]
+fn a_seed_grows_to_a_sphere_iso_surface() {
+    let c = Point3::new(24.0, 24.0, 24.0);
+    let r = 15.0;
+    let sdf = move |p: Point3| (p - c).norm() - r;
+    let vol = sdf_volume([48, 48, 48], [1.0; 3], sdf);
+    let params = RecoverParams {
+        boundary: BoundaryModel::Iso { value: 0.5 },
+        ..Default::default()
+    };
+    let prepared = prepare_volume(&vol, &params).unwrap();
+    let init = seed_cage(c + subdyn::math::Vector3::new(2.0, -1.0, 1.0), 3.0).unwrap();
+    let out = recover_shape(&prepared, &init, &params, &mut |_, _, _| {}).unwrap();
+    for l in &out.report.levels {
+        println!(
+            "level {} cps {} samples {} steps {} p95 {:.3} vox unresolved {:.3} {:.2}s",
+            l.level, l.control_points, l.samples, l.steps, l.offsets.p95, l.unresolved, l.seconds
+        );
+    }
+    let (max, mean) = surface_error(&out.control, sdf);
+    println!(
+        "sphere: max {max:.3} mean {mean:.3} voxels; {}",
+        out.report.stop_reason
+    );
+    assert!(out.report.converged, "{}", out.report.stop_reason);
+    assert!(mean < 0.25 && max < 1.0, "mean {mean} max {max}");
+}
+
+#[test]
+fn a_torus_is_recovered_from_its_thresholded_component_with_edges() {
+    let c = Point3::new(30.0, 30.0, 20.0);
+    let (big, small) = (18.0, 7.0);
+    let sdf = move |p: Point3| {
+        let d = p - c;
+        let q = ((d.x * d.x + d.y * d.y).sqrt() - big, d.z);
+        (q.0 * q.0 + q.1 * q.1).sqrt() - small
+    };
+    // Anisotropic voxels: 1 × 1 × 1.5.
+    let vol = sdf_volume([60, 60, 27], [1.0, 1.0, 1.5], sdf);
+    let params = RecoverParams::default();
+    let prepared = prepare_volume(&vol, &params).unwrap();
+    let cage = component_cage(&prepared.smoothed, prepared.inside_level, true, None, 12).unwrap();
+    assert_eq!(cage.genus, 1);
+    let out = recover_shape(&prepared, &cage.mesh, &params, &mut |_, _, _| {}).unwrap();
+    for l in &out.report.levels {
+        println!(
+            "level {} cps {} samples {} steps {} p95 {:.3} vox unresolved {:.3} {:.2}s",
+            l.level, l.control_points, l.samples, l.steps, l.offsets.p95, l.unresolved, l.seconds
+        );
+    }
+    let (max, mean) = surface_error(&out.control, sdf);
+    println!(
+        "torus: max {max:.3} mean {mean:.3}; {}",
+        out.report.stop_reason
+    );
+    assert!(mean < 0.3 && max < 1.5, "mean {mean} max {max}");
+}
