@@ -36,6 +36,7 @@ mod plot;
 mod raster;
 mod scene;
 mod shading;
+mod slices;
 mod viridis;
 
 pub use camera::{Camera, Projection, ScreenPoint};
@@ -49,3 +50,4 @@ pub use scene::{
     BACK, CloudLayer, EDGES, MAX_WORK_PIXELS, MeshLayer, POINTS, RenderOptions, SURFACE, Scene,
 };
 pub use shading::{AMBIENT, corner_normals, face_normals};
+pub use slices::slice_overlay;

@@ -1,0 +1,350 @@
+//! `subdyn recover VOLUME [--seed x,y,z | --auto] [--iso T] -o SHAPE.obj`:
+//! recover a closed shape from a volume (MRI, CT, slice stack) with a
+//! dynamic Catmull-Clark surface pulled by image forces.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use serde_json::json;
+
+use subdyn::fit::recover::{
+    PreparedVolume, RecoverParams, RecoverReport, component_cage, prepare_volume, recover_shape,
+    seed_cage,
+};
+use subdyn::forces::BoundaryModel;
+use subdyn::io::{VolumeReadOptions, read_volume, write_mesh};
+use subdyn::limit::tessellate;
+use subdyn::math::{Point3, Real};
+use subdyn::mesh::PolyMesh;
+use subdyn::subdivision::{RefineOptions, Refiner};
+
+use super::common::{about_file, check_mesh_output, print_stdout, seconds, thousands, write_report};
+use super::options::read_polygon_mesh;
+use super::progress::Progress;
+
+/// Arguments of `subdyn recover`.
+#[derive(Debug, Args)]
+pub struct RecoverArgs {
+    /// The volume: a NIfTI-1 file (.nii, .nii.gz), a multi-page TIFF, a
+    /// directory of PNG/TIFF/EXR slices (sorted by the number in the name),
+    /// or a raw file with its JSON header.
+    #[arg(value_name = "VOLUME")]
+    pub input: PathBuf,
+    /// Output control mesh; the format follows the extension.
+    #[arg(short, long, value_name = "SHAPE", default_value = "shape.obj")]
+    pub output: PathBuf,
+    /// Grow the model from a small sphere at this world point (x,y,z), which
+    /// must lie inside the object. Genus 0 only.
+    #[arg(long, value_name = "x,y,z", value_parser = parse_triple, conflicts_with_all = ["auto", "init"])]
+    pub seed: Option<[f64; 3]>,
+    /// Start from the boundary of the largest connected component above the
+    /// inside level (the iso-value, or Otsu's threshold); any genus. The default.
+    #[arg(long)]
+    pub auto: bool,
+    /// Start from this closed control mesh instead (world coordinates).
+    #[arg(long, value_name = "MESH", conflicts_with = "auto")]
+    pub init: Option<PathBuf>,
+    /// The boundary is the level set at this intensity (e.g. CT Hounsfield
+    /// units, 0.5 of a probability map). Without it the boundary is the
+    /// strongest nearby edge of the smoothed image.
+    #[arg(long, value_name = "T")]
+    pub iso: Option<f64>,
+    /// Weakest edge accepted without --iso, as a fraction of the volume's strongest.
+    #[arg(long, value_name = "F", default_value_t = 0.1)]
+    pub edge_strength: f64,
+    /// The object is darker than its surroundings (ventricles in T1 MRI, air).
+    #[arg(long)]
+    pub dark: bool,
+    /// Gaussian smoothing σ in world units (default: one voxel).
+    #[arg(long, value_name = "S")]
+    pub sigma: Option<f64>,
+    /// Voxel spacing for formats without it (world = origin + index × spacing).
+    #[arg(long, value_name = "sx,sy,sz", value_parser = parse_triple)]
+    pub spacing: Option<[f64; 3]>,
+    /// World position of voxel (0,0,0) for formats without it.
+    #[arg(long, value_name = "ox,oy,oz", value_parser = parse_triple)]
+    pub origin: Option<[f64; 3]>,
+    /// Stop when the 95th percentile of the surface-to-boundary offsets is below this many voxels.
+    #[arg(long, value_name = "VOXELS", default_value_t = 0.5)]
+    pub tol: f64,
+    /// Subdivision levels allowed above the initial cage.
+    #[arg(long, value_name = "L", default_value_t = 3)]
+    pub max_level: usize,
+    /// Cells along the object's longest side for --auto's cage.
+    #[arg(long, value_name = "N", default_value_t = 12)]
+    pub resolution: usize,
+    /// Radius of the --seed sphere in voxels.
+    #[arg(long, value_name = "VOXELS", default_value_t = 3.0)]
+    pub seed_radius: f64,
+    /// Bending weight λ_b of the thin plate.
+    #[arg(long, value_name = "λ", default_value_t = RecoverParams::default().bending)]
+    pub bending: f64,
+    /// Also write a dense limit-surface tessellation (K×K per quad, see --tess).
+    #[arg(long, value_name = "SURF")]
+    pub limit_out: Option<PathBuf>,
+    /// Tessellation rate of --limit-out and of the slice contours.
+    #[arg(long, value_name = "K", default_value_t = 4)]
+    pub tess: usize,
+    /// Write a JSON report (stage times, per level: control points, steps, offsets).
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<PathBuf>,
+    /// Write slices with the recovered contour (yellow) and the initial one
+    /// (blue) over the image to this directory: three z slices, one y, one x.
+    #[arg(long, value_name = "DIR")]
+    pub slices_png: Option<PathBuf>,
+    /// No progress display.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+fn parse_triple(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("'{s}': {e}; expected three numbers x,y,z"))?;
+    match v.as_slice() {
+        [a, b, c] if v.iter().all(|x| x.is_finite()) => Ok([*a, *b, *c]),
+        _ => Err(format!("'{s}': expected three finite numbers x,y,z")),
+    }
+}
+
+/// Runs `subdyn recover`.
+pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
+    let start = Instant::now();
+    check_mesh_output(&args.output)?;
+    if let Some(p) = &args.limit_out {
+        check_mesh_output(p)?;
+    }
+    if args.tess == 0 || args.tess > 64 {
+        anyhow::bail!("--tess {} is out of range: expected 1 to 64", args.tess);
+    }
+    let params = RecoverParams {
+        boundary: match args.iso {
+            Some(value) => BoundaryModel::Iso { value },
+            None => BoundaryModel::Edge {
+                min_strength: args.edge_strength,
+            },
+        },
+        sigma: args.sigma,
+        bright_inside: !args.dark,
+        tolerance_voxels: args.tol,
+        max_level: args.max_level,
+        bending: args.bending,
+        ..Default::default()
+    };
+    params.check()?;
+    let progress = Progress::new(args.quiet);
+    progress.stage(format!("reading {}", args.input.display()));
+    let t = Instant::now();
+    let file = read_volume(
+        &args.input,
+        &VolumeReadOptions {
+            spacing: args.spacing,
+            origin: args.origin,
+        },
+    )
+    .map_err(|e| about_file(e, &args.input))?;
+    let read_s = seconds(t);
+    let volume = &file.volume;
+    progress.stage("smoothing and edge detection");
+    let prepared = prepare_volume(volume, &params)
+        .map_err(|e| anyhow::Error::new(e).context(format!("preparing {}", args.input.display())))?;
+    progress.stage("building the initial model");
+    let t = Instant::now();
+    let (init, init_json) = initial_model(args, &prepared)?;
+    let init_s = seconds(t);
+    let mut on_step = |level: usize, step: usize, energy: f64| {
+        progress.stage(format!("level {level}, step {step}: energy {energy:.4e}"));
+    };
+    let result = recover_shape(&prepared, &init, &params, &mut on_step)
+        .map_err(|e| anyhow::Error::new(e).context(format!("recovering from {}", args.input.display())))?;
+    progress.stage(format!("writing {}", args.output.display()));
+    write_mesh(&args.output, &result.control, None).map_err(|e| about_file(e, &args.output))?;
+    let surface = |mesh: &PolyMesh| -> anyhow::Result<(PolyMesh, Vec<subdyn::math::Vector3>)> {
+        let refiner = Refiner::new(mesh, &RefineOptions::default())?;
+        Ok(tessellate(&refiner, &mesh.positions, args.tess)?)
+    };
+    let (surf, normals) = surface(&result.control)?;
+    if let Some(path) = &args.limit_out {
+        write_mesh(path, &surf, Some(&normals)).map_err(|e| about_file(e, path))?;
+    }
+    let mut slice_files = Vec::new();
+    if let Some(dir) = &args.slices_png {
+        progress.stage("drawing slices");
+        let (init_surf, _) = surface(&init)?;
+        slice_files = write_slices(dir, volume, &surf, &init_surf)?;
+    }
+    drop(progress);
+    if let Some(path) = &args.report {
+        let value = json!({
+            "command": "recover",
+            "input": args.input.display().to_string(),
+            "format": file.source,
+            "notes": file.notes,
+            "dims": volume.dims(),
+            "spacing": volume.spacing(),
+            "origin": [volume.origin().x, volume.origin().y, volume.origin().z],
+            "output": args.output.display().to_string(),
+            "limit_out": args.limit_out.as_ref().map(|p| p.display().to_string()),
+            "init": init_json,
+            "stages_s": {
+                "read": read_s,
+                "smoothing": prepared.smoothing_seconds,
+                "potential": prepared.potential_seconds,
+                "init": init_s,
+                "evolution": result.report.levels.iter().map(|l| l.seconds).sum::<f64>(),
+            },
+            "recover": serde_json::to_value(&result.report)?,
+            "slices": slice_files,
+            "total_s": seconds(start),
+        });
+        write_report(path, &value)?;
+    }
+    let mut text = summary(args, &file.notes, read_s, init_s, &result.report);
+    if !slice_files.is_empty() {
+        text.push_str(&format!(
+            "slices: {} PNGs in {}\n",
+            slice_files.len(),
+            args.slices_png.as_ref().map_or(String::new(), |d| d.display().to_string())
+        ));
+    }
+    print_stdout(&text)
+}
+
+/// The initial control mesh from --seed, --init or --auto.
+fn initial_model(
+    args: &RecoverArgs,
+    prepared: &PreparedVolume,
+) -> anyhow::Result<(PolyMesh, serde_json::Value)> {
+    let volume = &prepared.smoothed;
+    if let Some(s) = args.seed {
+        let p = Point3::new(s[0], s[1], s[2]);
+        if !volume.contains(&p) {
+            let (lo, hi) = volume.world_bounds();
+            anyhow::bail!(
+                "--seed ({}, {}, {}) lies outside the volume, which spans ({:.2}, {:.2}, {:.2}) to ({:.2}, {:.2}, {:.2})",
+                s[0], s[1], s[2], lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+            );
+        }
+        let v = volume.sample(&p);
+        let inside = if args.dark { v < prepared.inside_level } else { v > prepared.inside_level };
+        if !inside {
+            anyhow::bail!(
+                "--seed ({}, {}, {}) is not inside the object: the smoothed intensity there is {v:.4}, {} the inside level {:.4}",
+                s[0], s[1], s[2],
+                if args.dark { "not below" } else { "not above" },
+                prepared.inside_level
+            );
+        }
+        if !(args.seed_radius.is_finite() && args.seed_radius > 0.0) {
+            anyhow::bail!("--seed-radius {} must be positive", args.seed_radius);
+        }
+        let mesh = seed_cage(p, args.seed_radius * volume.voxel_size())?;
+        let value = json!({"method": "seed", "seed": s, "radius_voxels": args.seed_radius,
+            "vertices": mesh.num_vertices(), "faces": mesh.num_faces()});
+        return Ok((mesh, value));
+    }
+    if let Some(path) = &args.init {
+        let mesh = read_polygon_mesh(path, args.quiet)?;
+        let value = json!({"method": "file", "path": path.display().to_string(),
+            "vertices": mesh.num_vertices(), "faces": mesh.num_faces()});
+        return Ok((mesh, value));
+    }
+    if !(2..=128).contains(&args.resolution) {
+        anyhow::bail!("--resolution {} is out of range: expected 2 to 128", args.resolution);
+    }
+    let cage = component_cage(
+        volume,
+        prepared.inside_level,
+        !args.dark,
+        None,
+        args.resolution,
+    )?;
+    let value = json!({"method": "auto", "component_voxels": cage.voxels,
+        "components": cage.components, "block_voxels": cage.block, "genus": cage.genus,
+        "vertices": cage.mesh.num_vertices(), "faces": cage.mesh.num_faces()});
+    Ok((cage.mesh, value))
+}
+
+/// Three z slices through the object (at a quarter, half and three
+/// quarters of its extent), and the middle y and x slices.
+fn write_slices(
+    dir: &Path,
+    volume: &subdyn::volume::Volume,
+    surface: &PolyMesh,
+    initial: &PolyMesh,
+) -> anyhow::Result<Vec<String>> {
+    use subdyn::render::{slice_overlay, write_png};
+    std::fs::create_dir_all(dir).map_err(|e| about_file(subdyn::Error::io(dir, e), dir))?;
+    let idx: Vec<[Real; 3]> = surface.positions.iter().map(|p| volume.continuous_index(p)).collect();
+    let dims = volume.dims();
+    let extent = |a: usize| {
+        let lo = idx.iter().map(|c| c[a]).fold(Real::INFINITY, Real::min).max(0.0);
+        let hi = idx.iter().map(|c| c[a]).fold(Real::NEG_INFINITY, Real::max).min((dims[a] - 1) as Real);
+        (lo, hi)
+    };
+    let at = |a: usize, f: Real| {
+        let (lo, hi) = extent(a);
+        ((lo + f * (hi - lo)).round().max(0.0) as usize).min(dims[a] - 1)
+    };
+    let views = [(2, at(2, 0.25)), (2, at(2, 0.5)), (2, at(2, 0.75)), (1, at(1, 0.5)), (0, at(0, 0.5))];
+    let mut files = Vec::new();
+    for (axis, index) in views {
+        let pic = slice_overlay(
+            volume,
+            axis,
+            index,
+            512,
+            &[(initial, [60, 140, 255]), (surface, [255, 220, 0])],
+        )?;
+        let path = dir.join(format!("slice_{}{index:04}.png", ["x", "y", "z"][axis]));
+        write_png(&path, &pic).map_err(|e| about_file(e, &path))?;
+        files.push(path.display().to_string());
+    }
+    Ok(files)
+}
+
+fn summary(
+    args: &RecoverArgs,
+    notes: &[String],
+    read_s: f64,
+    init_s: f64,
+    r: &RecoverReport,
+) -> String {
+    let mut s = format!(
+        "recovered {} in {:.2} s: {}\n",
+        args.input.display(),
+        r.seconds + read_s + init_s,
+        r.stop_reason
+    );
+    for n in notes {
+        s.push_str(&format!("note: {n}\n"));
+    }
+    s.push_str(&format!(
+        "stages: read {read_s:.2} s, smoothing {:.2} s, edges {:.2} s, initial model {init_s:.2} s; voxel {:.4}, σ {:.4}, inside level {:.4}\n",
+        r.smoothing_seconds, r.potential_seconds, r.voxel, r.sigma, r.inside_level
+    ));
+    s.push_str("level  control points  samples  steps  seconds  p95 vox  RMS vox  max vox  unresolved\n");
+    for l in &r.levels {
+        s.push_str(&format!(
+            "{:>5}  {:>14}  {:>7}  {:>5}  {:>7.2}  {:>7.3}  {:>7.3}  {:>7.3}  {:>9.1}%\n",
+            l.level,
+            thousands(l.control_points),
+            thousands(l.samples),
+            l.steps,
+            l.seconds,
+            l.offsets.p95,
+            l.offsets.rms,
+            l.offsets.max,
+            100.0 * l.unresolved
+        ));
+    }
+    s.push_str(&format!("wrote {}", args.output.display()));
+    if let Some(p) = &args.limit_out {
+        s.push_str(&format!(" and {}", p.display()));
+    }
+    s.push('\n');
+    s
+}
