@@ -1,4 +1,5 @@
-//! Reading and writing meshes, point clouds and crease lists.
+//! Reading and writing meshes, point clouds and crease lists; reading
+//! volumes ([`read_volume`]: NIfTI-1, slice directories, TIFF, EXR, raw + JSON).
 //!
 //! Formats: OBJ, PLY (ASCII and binary, either byte order), OFF and XYZ, each
 //! optionally gzip-compressed (`.ply.gz`, `.obj.gz`, …). The format follows the
@@ -22,6 +23,7 @@ mod raw;
 mod read;
 mod source;
 mod text;
+mod volume;
 mod write;
 mod xyz;
 
@@ -31,4 +33,5 @@ pub use format::MeshFormat;
 pub use read::{
     read_mesh, read_mesh_from_bytes, read_obj_from_bytes, read_points, read_points_from_bytes,
 };
+pub use volume::{VolumeFile, VolumeFormat, VolumeReadOptions, read_volume};
 pub use write::{write_mesh, write_points};

@@ -1,0 +1,90 @@
+//! NIfTI-1 single-file volumes, `.nii` and `.nii.gz` (gzip is recognised by
+//! its magic bytes, whatever the name). The header is parsed by
+//! [`nifti_header`](super::nifti_header); the voxels are streamed from the
+//! (decompressing) reader straight into f32, so a `.nii.gz` is never held
+//! uncompressed in full.
+
+use std::fs::File;
+use std::io::{BufReader, Read};
+use std::path::Path;
+
+use flate2::read::MultiGzDecoder;
+
+use super::decoded::{Decoded, Placement};
+use super::nifti_header::{NIFTI1_HEADER_BYTES, nifti_header};
+use super::samples::{read_samples, skip_bytes};
+use crate::error::{Error, Result};
+
+/// Reads the first 3D volume of a NIfTI-1 file, in physical units
+/// (`scl_slope`, `scl_inter` applied) and world coordinates (see
+/// [`nifti_header`](super::nifti_header) for the map).
+pub(crate) fn read_nifti(path: &Path) -> Result<Decoded> {
+    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut buffered = BufReader::with_capacity(1 << 16, file);
+    let mut magic = [0u8; 2];
+    let gzip = {
+        use std::io::BufRead;
+        let head = buffered.fill_buf().map_err(|e| Error::io(path, e))?;
+        if head.len() >= 2 {
+            magic.copy_from_slice(&head[..2]);
+        }
+        magic == [0x1f, 0x8b]
+    };
+    let mut reader: Box<dyn Read> = if gzip {
+        Box::new(BufReader::with_capacity(
+            1 << 16,
+            MultiGzDecoder::new(buffered),
+        ))
+    } else {
+        Box::new(buffered)
+    };
+
+    let mut head = Vec::with_capacity(NIFTI1_HEADER_BYTES);
+    (&mut reader)
+        .take(NIFTI1_HEADER_BYTES as u64)
+        .read_to_end(&mut head)
+        .map_err(|e| Error::parse(path, 0, format!("reading the header: {e}")))?;
+    let header = nifti_header(&head, path)?;
+    let gap = header.vox_offset - NIFTI1_HEADER_BYTES as u64;
+    if !skip_bytes(&mut reader, gap, path)? {
+        return Err(Error::parse(
+            path,
+            0,
+            format!(
+                "vox_offset {} is beyond the end of the file",
+                header.vox_offset
+            ),
+        ));
+    }
+    let count = header.dims.iter().product();
+    let mut data = read_samples(&mut reader, count, header.datatype, header.big_endian, path)?;
+    if let Some((slope, inter)) = header.scaling {
+        for v in data.iter_mut() {
+            *v = (slope * f64::from(*v) + inter) as f32;
+        }
+    }
+    let mut notes = vec![format!("voxel-to-world map from the {}", header.method)];
+    notes.extend(header.notes);
+    if header.volumes > 1 {
+        notes.push(format!(
+            "the file holds {} volumes; only the first is read",
+            header.volumes
+        ));
+    }
+    Ok(Decoded {
+        dims: header.dims,
+        data,
+        placement: Placement::Affine {
+            linear: header.linear,
+            origin: header.origin,
+        },
+        source: format!(
+            "NIfTI-1{}, {}, {}-endian",
+            if gzip { " (gzip)" } else { "" },
+            header.datatype.name(),
+            if header.big_endian { "big" } else { "little" }
+        ),
+        notes,
+        physical: true,
+    })
+}

@@ -1,0 +1,275 @@
+//! Slice directories: one 2D image per z, PNG (8/16-bit grey), TIFF or
+//! single-channel EXR, stacked in the order of the number in each file name
+//! (`slice_9.png` before `slice_10.png`: numbers, not text, are compared).
+//!
+//! Conventions: column = x, row = y (the first row of the file is y = 0),
+//! slice order = z. Files with other extensions (`volume.json`,
+//! `truth.obj`, …) are ignored; slice files of two kinds (`.png` and
+//! `.tif`) in one directory are an error, as are slices of different sizes
+//! or bit depths (naming the first file that differs). Colour PNGs are
+//! converted to grey (luma, Rec. 709 weights, as the `image` crate does)
+//! with a note; an alpha channel is dropped with a note. A TIFF file
+//! contributes every page it has, in page order.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+use image::DynamicImage;
+use rayon::prelude::*;
+
+use super::decoded::{Decoded, Placement};
+use super::exr::exr_slice;
+use super::tiff::tiff_pages;
+use crate::error::{Error, Result};
+
+/// One decoded 2D image.
+#[derive(Clone, Debug)]
+pub(crate) struct Slice {
+    /// Columns (x).
+    pub width: usize,
+    /// Rows (y).
+    pub height: usize,
+    /// Stored sample kind, for mixed-depth checks: `8-bit grey`, `32-bit float`, …
+    pub kind: String,
+    /// Samples, row 0 first, as f32.
+    pub samples: Vec<f32>,
+    /// A remark (colour converted, alpha dropped).
+    pub note: Option<String>,
+}
+
+/// Reads the slice directory `dir`.
+pub(crate) fn read_slice_dir(dir: &Path) -> Result<Decoded> {
+    let files = slice_files(dir)?;
+    let ext = files[0]
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let decoded: Vec<Vec<Slice>> = files
+        .par_iter()
+        .map(|f| decode_file(f))
+        .collect::<Result<_>>()?;
+    let slices: Vec<(&PathBuf, Slice)> = files
+        .iter()
+        .zip(decoded)
+        .flat_map(|(f, pages)| pages.into_iter().map(move |s| (f, s)))
+        .collect();
+    let mut data = stack(&slices)?;
+    let notes: BTreeSet<String> = slices.iter().filter_map(|(_, s)| s.note.clone()).collect();
+    let (first_name, s0) = (&slices[0].0, &slices[0].1);
+    let dims = [s0.width, s0.height, slices.len()];
+    let source = format!(
+        "{} .{ext} slices ({}), {} to {}",
+        slices.len(),
+        s0.kind,
+        name(first_name),
+        name(files[files.len() - 1].as_path())
+    );
+    data.shrink_to_fit();
+    Ok(Decoded {
+        dims,
+        data,
+        placement: Placement::Grid { spacing: None },
+        source,
+        notes: notes.into_iter().collect(),
+        physical: false,
+    })
+}
+
+/// Stacks the slices in order, checking that they agree in size and kind.
+pub(crate) fn stack(slices: &[(&PathBuf, Slice)]) -> Result<Vec<f32>> {
+    let (first, s0) = &slices[0];
+    let mut data = Vec::with_capacity(s0.samples.len() * slices.len());
+    for (path, s) in slices {
+        if (s.width, s.height) != (s0.width, s0.height) {
+            return Err(Error::parse(
+                path.as_path(),
+                0,
+                format!(
+                    "slice is {}×{} but {} is {}×{}: every slice must have the same size",
+                    s.width,
+                    s.height,
+                    name(first),
+                    s0.width,
+                    s0.height
+                ),
+            ));
+        }
+        if s.kind != s0.kind {
+            return Err(Error::parse(
+                path.as_path(),
+                0,
+                format!(
+                    "slice is {} but {} is {}: mixed bit depths",
+                    s.kind,
+                    name(first),
+                    s0.kind
+                ),
+            ));
+        }
+        data.extend_from_slice(&s.samples);
+    }
+    Ok(data)
+}
+
+/// The slice files of `dir` sorted by the number in their names.
+fn slice_files(dir: &Path) -> Result<Vec<PathBuf>> {
+    let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
+    let mut found: Vec<(u64, PathBuf)> = Vec::new();
+    let mut kinds = BTreeSet::new();
+    for entry in entries {
+        let path = entry.map_err(|e| Error::io(dir, e))?.path();
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        let kind = match ext.as_str() {
+            "png" => "PNG",
+            "tif" | "tiff" => "TIFF",
+            "exr" => "EXR",
+            _ => continue,
+        };
+        if !path.is_file() {
+            continue;
+        }
+        kinds.insert(kind);
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let number = last_number(&stem).ok_or_else(|| {
+            Error::parse(
+                &path,
+                0,
+                "a slice file without a number in its name: the number gives the slice order",
+            )
+        })?;
+        found.push((number, path));
+    }
+    if found.is_empty() {
+        return Err(Error::parse(
+            dir,
+            0,
+            "no slice images (.png, .tif, .tiff, .exr) in this directory",
+        ));
+    }
+    if kinds.len() > 1 {
+        let list: Vec<&str> = kinds.into_iter().collect();
+        return Err(Error::parse(
+            dir,
+            0,
+            format!(
+                "slices of several kinds ({}): keep one kind per directory",
+                list.join(", ")
+            ),
+        ));
+    }
+    found.sort();
+    for pair in found.windows(2) {
+        if pair[0].0 == pair[1].0 {
+            return Err(Error::parse(
+                &pair[1].1,
+                0,
+                format!(
+                    "has the same slice number {} as {}",
+                    pair[0].0,
+                    name(&pair[0].1)
+                ),
+            ));
+        }
+    }
+    Ok(found.into_iter().map(|(_, p)| p).collect())
+}
+
+/// The last run of decimal digits in `s` (`slice_0012_t1` → 12).
+fn last_number(s: &str) -> Option<u64> {
+    let end = s.rfind(|c: char| c.is_ascii_digit())? + 1;
+    let start = s[..end]
+        .rfind(|c: char| !c.is_ascii_digit())
+        .map_or(0, |i| i + 1);
+    s[start..end].parse().ok()
+}
+
+/// Decodes one slice file (a TIFF may hold several pages).
+fn decode_file(path: &Path) -> Result<Vec<Slice>> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "png" => Ok(vec![png_slice(path)?]),
+        "exr" => Ok(vec![exr_slice(path)?]),
+        _ => tiff_pages(path).map(|(pages, _)| pages),
+    }
+}
+
+/// Decodes a PNG: 8/16-bit grey kept as stored; colour converted to luma.
+fn png_slice(path: &Path) -> Result<Slice> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+        .map_err(|e| Error::parse(path, 0, format!("cannot decode the PNG: {e}")))?;
+    let (width, height) = (img.width() as usize, img.height() as usize);
+    let (kind, note, samples): (&str, Option<&str>, Vec<f32>) = match img {
+        DynamicImage::ImageLuma8(b) => ("8-bit grey", None, to_f32(b.as_raw())),
+        DynamicImage::ImageLuma16(b) => ("16-bit grey", None, to_f32(b.as_raw())),
+        DynamicImage::ImageLumaA8(_) => (
+            "8-bit grey",
+            Some("alpha channel of the slices ignored"),
+            to_f32(img.to_luma8().as_raw()),
+        ),
+        DynamicImage::ImageLumaA16(_) => (
+            "16-bit grey",
+            Some("alpha channel of the slices ignored"),
+            to_f32(img.to_luma16().as_raw()),
+        ),
+        DynamicImage::ImageRgb8(_) | DynamicImage::ImageRgba8(_) => (
+            "8-bit grey",
+            Some("colour slices converted to grey (Rec. 709 luma)"),
+            to_f32(img.to_luma8().as_raw()),
+        ),
+        DynamicImage::ImageRgb16(_) | DynamicImage::ImageRgba16(_) => (
+            "16-bit grey",
+            Some("colour slices converted to grey (Rec. 709 luma)"),
+            to_f32(img.to_luma16().as_raw()),
+        ),
+        other => {
+            return Err(Error::parse(
+                path,
+                0,
+                format!("unsupported PNG colour type {:?}", other.color()),
+            ));
+        }
+    };
+    Ok(Slice {
+        width,
+        height,
+        kind: kind.into(),
+        samples,
+        note: note.map(str::to_string),
+    })
+}
+
+/// Integer samples as f32.
+fn to_f32<T: Copy + Into<f32>>(v: &[T]) -> Vec<f32> {
+    v.iter().map(|&x| x.into()).collect()
+}
+
+/// The file name of `path`, for messages.
+pub(crate) fn name(path: &Path) -> String {
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_last_number_in_a_name_orders_slices() {
+        assert_eq!(last_number("slice_10"), Some(10));
+        assert_eq!(last_number("img007"), Some(7));
+        assert_eq!(last_number("t1_slice_12_x"), Some(12));
+        assert_eq!(last_number("slice"), None);
+    }
+}
