@@ -18,7 +18,7 @@ fn volume_from(dims: [usize; 3], spacing: [Real; 3], f: impl Fn([usize; 3]) -> f
 
 #[test]
 fn samples_sit_at_voxel_centres_and_a_linear_ramp_is_interpolated_exactly() {
-    let ramp = |c: [usize; 3]| (2.0 * c[0] as f32 - c[1] as f32 + 0.5 * c[2] as f32);
+    let ramp = |c: [usize; 3]| 2.0 * c[0] as f32 - c[1] as f32 + 0.5 * c[2] as f32;
     let v = volume_from([5, 6, 7], [0.5, 1.0, 2.0], ramp);
     // World of index (i, j, k) = origin + (0.5 i, j, 2 k).
     let p = v.world([1.0, 2.0, 3.0]);

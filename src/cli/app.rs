@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use super::{bench, common, compare, fit, info, limit, render, subdivide};
+use super::{bench, common, compare, fit, info, limit, recover, render, subdivide};
 
 /// subdyn: Catmull-Clark subdivision surfaces — refinement as stencil tables,
 /// exact limit evaluation, mesh inspection and benchmarks.
@@ -26,6 +26,8 @@ struct Cli {
 enum Command {
     /// Fit a dynamic Catmull-Clark surface to a point cloud (the embedded demo scan when no SCAN is given).
     Fit(fit::FitArgs),
+    /// Recover a closed shape from a volume (NIfTI, slice stack, TIFF, EXR, raw) with image forces.
+    Recover(recover::RecoverArgs),
     /// Refine a mesh uniformly with Catmull-Clark (the embedded cube when no INPUT is given).
     Subdivide(subdivide::SubdivideArgs),
     /// Tessellate the limit surface: every quad face as a K×K grid of exact limit samples.
@@ -48,6 +50,7 @@ pub fn run() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Fit(args) => fit::run(&args),
+        Command::Recover(args) => recover::run(&args),
         Command::Subdivide(args) => subdivide::run(&args),
         Command::Limit(args) => limit::run(&args),
         Command::Info(args) => info::run(&args),

@@ -12,6 +12,7 @@ mod limit;
 mod mesh_stats;
 mod options;
 mod progress;
+mod recover;
 mod render;
 mod subdivide;
 

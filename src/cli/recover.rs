@@ -19,7 +19,9 @@ use subdyn::math::{Point3, Real};
 use subdyn::mesh::PolyMesh;
 use subdyn::subdivision::{RefineOptions, Refiner};
 
-use super::common::{about_file, check_mesh_output, print_stdout, seconds, thousands, write_report};
+use super::common::{
+    about_file, check_mesh_output, print_stdout, seconds, thousands, write_report,
+};
 use super::options::read_polygon_mesh;
 use super::progress::Progress;
 
@@ -72,7 +74,7 @@ pub struct RecoverArgs {
     #[arg(long, value_name = "L", default_value_t = 3)]
     pub max_level: usize,
     /// Cells along the object's longest side for --auto's cage.
-    #[arg(long, value_name = "N", default_value_t = 12)]
+    #[arg(long, value_name = "N", default_value_t = 24)]
     pub resolution: usize,
     /// Radius of the --seed sphere in voxels.
     #[arg(long, value_name = "VOXELS", default_value_t = 3.0)]
@@ -149,8 +151,9 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     let read_s = seconds(t);
     let volume = &file.volume;
     progress.stage("smoothing and edge detection");
-    let prepared = prepare_volume(volume, &params)
-        .map_err(|e| anyhow::Error::new(e).context(format!("preparing {}", args.input.display())))?;
+    let prepared = prepare_volume(volume, &params).map_err(|e| {
+        anyhow::Error::new(e).context(format!("preparing {}", args.input.display()))
+    })?;
     progress.stage("building the initial model");
     let t = Instant::now();
     let (init, init_json) = initial_model(args, &prepared)?;
@@ -158,8 +161,9 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     let mut on_step = |level: usize, step: usize, energy: f64| {
         progress.stage(format!("level {level}, step {step}: energy {energy:.4e}"));
     };
-    let result = recover_shape(&prepared, &init, &params, &mut on_step)
-        .map_err(|e| anyhow::Error::new(e).context(format!("recovering from {}", args.input.display())))?;
+    let result = recover_shape(&prepared, &init, &params, &mut on_step).map_err(|e| {
+        anyhow::Error::new(e).context(format!("recovering from {}", args.input.display()))
+    })?;
     progress.stage(format!("writing {}", args.output.display()));
     write_mesh(&args.output, &result.control, None).map_err(|e| about_file(e, &args.output))?;
     let surface = |mesh: &PolyMesh| -> anyhow::Result<(PolyMesh, Vec<subdyn::math::Vector3>)> {
@@ -207,7 +211,9 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
         text.push_str(&format!(
             "slices: {} PNGs in {}\n",
             slice_files.len(),
-            args.slices_png.as_ref().map_or(String::new(), |d| d.display().to_string())
+            args.slices_png
+                .as_ref()
+                .map_or(String::new(), |d| d.display().to_string())
         ));
     }
     print_stdout(&text)
@@ -225,15 +231,29 @@ fn initial_model(
             let (lo, hi) = volume.world_bounds();
             anyhow::bail!(
                 "--seed ({}, {}, {}) lies outside the volume, which spans ({:.2}, {:.2}, {:.2}) to ({:.2}, {:.2}, {:.2})",
-                s[0], s[1], s[2], lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+                s[0],
+                s[1],
+                s[2],
+                lo.x,
+                lo.y,
+                lo.z,
+                hi.x,
+                hi.y,
+                hi.z
             );
         }
         let v = volume.sample(&p);
-        let inside = if args.dark { v < prepared.inside_level } else { v > prepared.inside_level };
+        let inside = if args.dark {
+            v < prepared.inside_level
+        } else {
+            v > prepared.inside_level
+        };
         if !inside {
             anyhow::bail!(
                 "--seed ({}, {}, {}) is not inside the object: the smoothed intensity there is {v:.4}, {} the inside level {:.4}",
-                s[0], s[1], s[2],
+                s[0],
+                s[1],
+                s[2],
                 if args.dark { "not below" } else { "not above" },
                 prepared.inside_level
             );
@@ -253,7 +273,10 @@ fn initial_model(
         return Ok((mesh, value));
     }
     if !(2..=128).contains(&args.resolution) {
-        anyhow::bail!("--resolution {} is out of range: expected 2 to 128", args.resolution);
+        anyhow::bail!(
+            "--resolution {} is out of range: expected 2 to 128",
+            args.resolution
+        );
     }
     let cage = component_cage(
         volume,
@@ -278,18 +301,36 @@ fn write_slices(
 ) -> anyhow::Result<Vec<String>> {
     use subdyn::render::{slice_overlay, write_png};
     std::fs::create_dir_all(dir).map_err(|e| about_file(subdyn::Error::io(dir, e), dir))?;
-    let idx: Vec<[Real; 3]> = surface.positions.iter().map(|p| volume.continuous_index(p)).collect();
+    let idx: Vec<[Real; 3]> = surface
+        .positions
+        .iter()
+        .map(|p| volume.continuous_index(p))
+        .collect();
     let dims = volume.dims();
     let extent = |a: usize| {
-        let lo = idx.iter().map(|c| c[a]).fold(Real::INFINITY, Real::min).max(0.0);
-        let hi = idx.iter().map(|c| c[a]).fold(Real::NEG_INFINITY, Real::max).min((dims[a] - 1) as Real);
+        let lo = idx
+            .iter()
+            .map(|c| c[a])
+            .fold(Real::INFINITY, Real::min)
+            .max(0.0);
+        let hi = idx
+            .iter()
+            .map(|c| c[a])
+            .fold(Real::NEG_INFINITY, Real::max)
+            .min((dims[a] - 1) as Real);
         (lo, hi)
     };
     let at = |a: usize, f: Real| {
         let (lo, hi) = extent(a);
         ((lo + f * (hi - lo)).round().max(0.0) as usize).min(dims[a] - 1)
     };
-    let views = [(2, at(2, 0.25)), (2, at(2, 0.5)), (2, at(2, 0.75)), (1, at(1, 0.5)), (0, at(0, 0.5))];
+    let views = [
+        (2, at(2, 0.25)),
+        (2, at(2, 0.5)),
+        (2, at(2, 0.75)),
+        (1, at(1, 0.5)),
+        (0, at(0, 0.5)),
+    ];
     let mut files = Vec::new();
     for (axis, index) in views {
         let pic = slice_overlay(
@@ -326,7 +367,9 @@ fn summary(
         "stages: read {read_s:.2} s, smoothing {:.2} s, edges {:.2} s, initial model {init_s:.2} s; voxel {:.4}, σ {:.4}, inside level {:.4}\n",
         r.smoothing_seconds, r.potential_seconds, r.voxel, r.sigma, r.inside_level
     ));
-    s.push_str("level  control points  samples  steps  seconds  p95 vox  RMS vox  max vox  unresolved\n");
+    s.push_str(
+        "level  control points  samples  steps  seconds  p95 vox  RMS vox  max vox  unresolved\n",
+    );
     for l in &r.levels {
         s.push_str(&format!(
             "{:>5}  {:>14}  {:>7}  {:>5}  {:>7.2}  {:>7.3}  {:>7.3}  {:>7.3}  {:>9.1}%\n",

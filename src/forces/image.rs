@@ -54,6 +54,30 @@ pub struct ImageField<'a> {
     pub bright_inside: bool,
 }
 
+/// Fraction of the smoothed volume's intensity range per voxel below which
+/// the image gradient is too weak to give a direction.
+const WEAK_GRADIENT: Real = 1e-3;
+
+impl ImageField<'_> {
+    /// The direction a point with no boundary in range moves: out of the
+    /// object when `inside`, into it otherwise — down the smoothed image's
+    /// gradient for bright objects (up for dark ones) where the gradient is
+    /// clear, else along `±n`. Following the image rather than the normal
+    /// keeps parts of the surface whose normal has turned from running away.
+    pub fn balloon_direction(&self, x: &Point3, n: &Vector3, inside: bool) -> Vector3 {
+        let (lo, hi) = self.smoothed.range();
+        let g = self.smoothed.gradient(x);
+        let outward = if self.bright_inside { -g } else { g };
+        let len = outward.norm();
+        let dir = if len * self.smoothed.voxel_size() > WEAK_GRADIENT * (hi - lo) as Real {
+            outward / len
+        } else {
+            *n
+        };
+        if inside { dir } else { -dir }
+    }
+}
+
 /// Where the search along one normal ended.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Offset {

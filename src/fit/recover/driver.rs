@@ -26,6 +26,7 @@ use crate::forces::{BoundaryModel, ImageField, Offset, inflation_force, row_spri
 use crate::limit::PatchTable;
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::PolyMesh;
+use crate::stencil::StencilTable;
 use crate::subdivision::{RefineOptions, Refiner};
 use crate::volume::{Volume, edge_potential, gaussian_smoothed, otsu_threshold};
 
@@ -146,7 +147,14 @@ pub fn recover_shape(
             ..Default::default()
         };
         let k = stiffness_matrix(&q, s, &material)?;
+        // Damping on the limit surface is blind to control-point modes that
+        // barely move it (a checkerboard over a coarse cage); a small
+        // proximal term on the control points themselves, 1 % of D's mean
+        // diagonal, keeps the solves from letting them drift.
         let d = damping_matrix(&q, s, None, params.damping / area)?;
+        let diag = d.diagonal();
+        let delta = 0.01 * diag.iter().sum::<Real>() / diag.len().max(1) as Real;
+        let d = d.linear_combination(1.0, &StencilTable::identity(diag.len()), delta)?;
         let kd = k.linear_combination(1.0, &d, 1.0)?;
         let sample_step = 0.25 * voxel;
         let search_of = |p: &[Point3]| {
@@ -178,12 +186,13 @@ pub fn recover_shape(
                     }
                     let n = nrm / da;
                     let o = field.boundary_offset(&xs[i], &n, range, sample_step);
-                    let t = match o {
-                        Offset::Boundary(t) => t,
-                        Offset::Inside => range,
-                        Offset::Outside => -range,
+                    let target = match o {
+                        Offset::Boundary(t) => xs[i] + t * n,
+                        Offset::Inside | Offset::Outside => {
+                            xs[i] + range * field.balloon_direction(&xs[i], &n, o == Offset::Inside)
+                        }
                     };
-                    (xs[i] + t * n, da * fs.weights[i], o)
+                    (target, da * fs.weights[i], o)
                 })
                 .collect();
             let total: Real = found.iter().map(|f| f.1).sum();
@@ -191,6 +200,12 @@ pub fn recover_shape(
                 return Err(Error::Input(
                     "the model's limit surface has no area; is the initial mesh degenerate?".into(),
                 ));
+            }
+            let outside = xs.iter().filter(|x| !field.smoothed.contains(x)).count();
+            if 2 * outside > xs.len() {
+                return Err(Error::NotConverged(format!(
+                    "the model left the volume at level {level}, step {steps}: start from a finer cage (--resolution) or a seed inside the object"
+                )));
             }
             let targets: Vec<Point3> = found.iter().map(|f| f.0).collect();
             let kw: Vec<Real> = found.iter().map(|f| f.1 / total).collect();
@@ -214,7 +229,9 @@ pub fn recover_shape(
             let settled = unresolved_area < 0.01
                 && (still
                     || energy.last().is_some_and(|&prev: &Real| {
-                        (prev - e).abs() <= params.energy_tolerance * prev.abs()
+                        let change = (prev - e).abs();
+                        change <= params.energy_tolerance * prev.abs()
+                            || change <= 0.5 * (params.settle_voxels * voxel).powi(2)
                     }));
             energy.push(e);
             if settled || steps >= max_steps {

@@ -25,9 +25,13 @@ pub struct RecoverParams {
     /// grows at gets four times as many).
     pub max_steps: usize,
     /// A level has settled when the energy changes by less than this fraction
-    /// between steps (default 1e-3) or no control point moves by more than
-    /// 1 % of a voxel.
+    /// between steps (default 1e-3), or by less than the energy of a uniform
+    /// misfit of `settle_voxels`, or no control point moves by more than 1 %
+    /// of a voxel.
     pub energy_tolerance: Real,
+    /// See `energy_tolerance` (default 0.05 voxel: the energy's slow creep
+    /// as the thin plate relaxes no longer moves the surface measurably).
+    pub settle_voxels: Real,
     /// Stop subdividing when a level lowers the RMS offset by less than this
     /// fraction (default 0.1).
     pub min_level_gain: Real,
@@ -61,6 +65,7 @@ impl Default for RecoverParams {
             max_level: 3,
             max_steps: 60,
             energy_tolerance: 1e-3,
+            settle_voxels: 0.05,
             min_level_gain: 0.1,
             min_edge_voxels: 2.0,
             search_voxels: None,
@@ -122,6 +127,7 @@ impl RecoverParams {
             )));
         }
         positive("energy tolerance", self.energy_tolerance)?;
+        non_negative("settle voxels", self.settle_voxels)?;
         non_negative("min level gain", self.min_level_gain)?;
         positive("min edge", self.min_edge_voxels)?;
         if let Some(s) = self.search_voxels {
