@@ -714,3 +714,53 @@ fn multipage_tiff_u16_and_f32_with_imagej_spacing() {
     let e = read_err(&dir.join("bad.tif"));
     assert!(e.contains("bad.tif") && e.contains("TIFF"), "{e}");
 }
+
+// ---------------------------------------------------------------------------
+// `subdyn info VOLUME`.
+
+#[test]
+fn info_prints_the_grid_of_a_volume_and_one_line_for_a_bad_one() {
+    let dir = scratch("info");
+    let mut h = Nifti::new([3, 2, 2], 2, 8);
+    h.sform = 1;
+    h.srow = [
+        [0.5, 0.0, 0.0, -4.0],
+        [0.0, 2.0, 0.0, 5.0],
+        [0.0, 0.0, 1.5, 6.0],
+    ];
+    let voxels: Vec<u8> = (0..12).map(|i| 10 + i).collect();
+    std::fs::write(dir.join("v.nii"), h.file(&voxels)).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_subdyn"))
+        .args(["info", "v.nii", "--json"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["kind"], "volume");
+    assert_eq!(v["dims"], serde_json::json!([3, 2, 2]));
+    assert_eq!(v["spacing"], serde_json::json!([0.5, 2.0, 1.5]));
+    assert_eq!(v["origin"], serde_json::json!([-4.0, 5.0, 6.0]));
+    assert_eq!(v["range"], serde_json::json!([10.0, 21.0]));
+    assert_eq!(v["world_box"]["max"], serde_json::json!([-3.0, 7.0, 7.5]));
+
+    let mut bad = h.clone();
+    bad.dims[0] = -1;
+    std::fs::write(dir.join("bad.nii"), bad.file(&voxels)).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_subdyn"))
+        .args(["info", "bad.nii"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("bad.nii") && err.contains("dim[1] = -1"),
+        "{err}"
+    );
+}
