@@ -764,3 +764,40 @@ fn info_prints_the_grid_of_a_volume_and_one_line_for_a_bad_one() {
         "{err}"
     );
 }
+
+#[test]
+fn tiff_slice_directory_and_4d_nifti() {
+    use tiff::encoder::{TiffEncoder, colortype};
+    let dir = scratch("tiff-dir");
+    let (nx, ny, nz) = (4usize, 3usize, 11usize);
+    for k in 0..nz {
+        let px: Vec<u16> = (0..ny)
+            .flat_map(|j| (0..nx).map(move |i| voxel(i, j, k)))
+            .collect();
+        let file = std::fs::File::create(dir.join(format!("img{k}.tif"))).unwrap();
+        TiffEncoder::new(file)
+            .unwrap()
+            .write_image::<colortype::Gray16>(nx as u32, ny as u32, &px)
+            .unwrap();
+    }
+    let vf = read(&dir);
+    assert_eq!(vf.volume.dims(), [nx, ny, nz]);
+    // img10 sorts after img9 by number.
+    assert_eq!(vf.volume.at(3, 2, 10), f32::from(voxel(3, 2, 10)));
+    assert_eq!(vf.volume.at(1, 0, 9), f32::from(voxel(1, 0, 9)));
+
+    // A 4D NIfTI: the first of three volumes, with a note.
+    let h = Nifti::new([2, 2, 2], 2, 8);
+    let mut h4 = h.clone();
+    h4.dims.push(3);
+    let voxels: Vec<u8> = (0..24).collect();
+    std::fs::write(dir.join("t.nii"), h4.file(&voxels)).unwrap();
+    let vf = read(&dir.join("t.nii"));
+    assert_eq!(vf.volume.dims(), [2, 2, 2]);
+    assert_eq!(vf.volume.data(), &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
+    assert!(
+        vf.notes.iter().any(|n| n.contains("3 volumes")),
+        "{:?}",
+        vf.notes
+    );
+}

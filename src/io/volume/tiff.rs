@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use ::tiff::ColorType;
 use ::tiff::decoder::ifd::Value;
-use ::tiff::decoder::{Decoder, DecodingResult, Limits};
+use ::tiff::decoder::{Decoder, DecodingResult};
 use ::tiff::tags::Tag;
 
 use super::decoded::{Decoded, Placement};
@@ -44,9 +44,9 @@ pub(crate) fn read_tiff_stack(path: &Path) -> Result<Decoded> {
 pub(crate) fn tiff_pages(path: &Path) -> Result<(Vec<Slice>, Option<[f64; 3]>)> {
     let bad = |e: ::tiff::TiffError| Error::parse(path, 0, format!("cannot decode the TIFF: {e}"));
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
-    let mut dec = Decoder::new(BufReader::new(file))
-        .map_err(bad)?
-        .with_limits(Limits::unlimited());
+    // The tiff crate's default limits (256 MiB per page) turn an absurd page
+    // size in a damaged header into an error instead of an allocation failure.
+    let mut dec = Decoder::new(BufReader::new(file)).map_err(bad)?;
     let spacing = imagej_spacing(&mut dec);
     let mut pages = Vec::new();
     loop {
