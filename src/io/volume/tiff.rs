@@ -10,7 +10,7 @@
 
 use std::fs::File;
 use std::io::BufReader;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use ::tiff::ColorType;
 use ::tiff::decoder::ifd::Value;
@@ -18,24 +18,25 @@ use ::tiff::decoder::{Decoder, DecodingResult};
 use ::tiff::tags::Tag;
 
 use super::decoded::{Decoded, Placement};
-use super::slices::{Slice, name, stack};
+use super::slices::{Slice, name, stacked};
 use crate::error::{Error, Result};
 
 /// Reads a (multi-page) TIFF file as a volume.
 pub(crate) fn read_tiff_stack(path: &Path) -> Result<Decoded> {
     let (pages, spacing) = tiff_pages(path)?;
     let owned = path.to_path_buf();
-    let slices: Vec<(&PathBuf, Slice)> = pages.into_iter().map(|s| (&owned, s)).collect();
-    let data = stack(&slices)?;
-    let s0 = &slices[0].1;
-    let mut notes: Vec<String> = slices.iter().filter_map(|(_, s)| s.note.clone()).collect();
-    notes.dedup();
+    let stack = stacked(pages.into_iter().map(|s| (&owned, s)).collect())?;
     Ok(Decoded {
-        dims: [s0.width, s0.height, slices.len()],
-        data,
+        dims: stack.dims,
+        source: format!(
+            "TIFF, {} pages ({}), {}",
+            stack.dims[2],
+            stack.kind,
+            name(path)
+        ),
+        data: stack.data,
         placement: Placement::Grid { spacing },
-        source: format!("TIFF, {} pages ({}), {}", slices.len(), s0.kind, name(path)),
-        notes,
+        notes: stack.notes,
         physical: false,
     })
 }
