@@ -714,3 +714,90 @@ fn multipage_tiff_u16_and_f32_with_imagej_spacing() {
     let e = read_err(&dir.join("bad.tif"));
     assert!(e.contains("bad.tif") && e.contains("TIFF"), "{e}");
 }
+
+// ---------------------------------------------------------------------------
+// `subdyn info VOLUME`.
+
+#[test]
+fn info_prints_the_grid_of_a_volume_and_one_line_for_a_bad_one() {
+    let dir = scratch("info");
+    let mut h = Nifti::new([3, 2, 2], 2, 8);
+    h.sform = 1;
+    h.srow = [
+        [0.5, 0.0, 0.0, -4.0],
+        [0.0, 2.0, 0.0, 5.0],
+        [0.0, 0.0, 1.5, 6.0],
+    ];
+    let voxels: Vec<u8> = (0..12).map(|i| 10 + i).collect();
+    std::fs::write(dir.join("v.nii"), h.file(&voxels)).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_subdyn"))
+        .args(["info", "v.nii", "--json"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["kind"], "volume");
+    assert_eq!(v["dims"], serde_json::json!([3, 2, 2]));
+    assert_eq!(v["spacing"], serde_json::json!([0.5, 2.0, 1.5]));
+    assert_eq!(v["origin"], serde_json::json!([-4.0, 5.0, 6.0]));
+    assert_eq!(v["range"], serde_json::json!([10.0, 21.0]));
+    assert_eq!(v["world_box"]["max"], serde_json::json!([-3.0, 7.0, 7.5]));
+
+    let mut bad = h.clone();
+    bad.dims[0] = -1;
+    std::fs::write(dir.join("bad.nii"), bad.file(&voxels)).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_subdyn"))
+        .args(["info", "bad.nii"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("bad.nii") && err.contains("dim[1] = -1"),
+        "{err}"
+    );
+}
+
+#[test]
+fn tiff_slice_directory_and_4d_nifti() {
+    use tiff::encoder::{TiffEncoder, colortype};
+    let dir = scratch("tiff-dir");
+    let (nx, ny, nz) = (4usize, 3usize, 11usize);
+    for k in 0..nz {
+        let px: Vec<u16> = (0..ny)
+            .flat_map(|j| (0..nx).map(move |i| voxel(i, j, k)))
+            .collect();
+        let file = std::fs::File::create(dir.join(format!("img{k}.tif"))).unwrap();
+        TiffEncoder::new(file)
+            .unwrap()
+            .write_image::<colortype::Gray16>(nx as u32, ny as u32, &px)
+            .unwrap();
+    }
+    let vf = read(&dir);
+    assert_eq!(vf.volume.dims(), [nx, ny, nz]);
+    // img10 sorts after img9 by number.
+    assert_eq!(vf.volume.at(3, 2, 10), f32::from(voxel(3, 2, 10)));
+    assert_eq!(vf.volume.at(1, 0, 9), f32::from(voxel(1, 0, 9)));
+
+    // A 4D NIfTI: the first of three volumes, with a note.
+    let h = Nifti::new([2, 2, 2], 2, 8);
+    let mut h4 = h.clone();
+    h4.dims.push(3);
+    let voxels: Vec<u8> = (0..24).collect();
+    std::fs::write(dir.join("t.nii"), h4.file(&voxels)).unwrap();
+    let vf = read(&dir.join("t.nii"));
+    assert_eq!(vf.volume.dims(), [2, 2, 2]);
+    assert_eq!(vf.volume.data(), &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
+    assert!(
+        vf.notes.iter().any(|n| n.contains("3 volumes")),
+        "{:?}",
+        vf.notes
+    );
+}

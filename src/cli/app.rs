@@ -32,7 +32,7 @@ enum Command {
     Subdivide(subdivide::SubdivideArgs),
     /// Tessellate the limit surface: every quad face as a K×K grid of exact limit samples.
     Limit(limit::LimitArgs),
-    /// Print counts, boundaries, components, genus, valences and the bounding box of a mesh or point file.
+    /// Print counts, boundaries, components, genus, valences and the bounding box of a mesh or point file, or the grid, world map and value range of a volume.
     Info(info::InfoArgs),
     /// Distances from A to B (B the reference): mean, RMS, 95th percentile, Hausdorff, Chamfer.
     Compare(compare::CompareArgs),

@@ -17,7 +17,8 @@ use super::mesh_stats::{MeshStats, mesh_stats};
 /// Arguments of `subdyn info`.
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Mesh or point file (.obj, .ply, .off, .xyz, optionally .gz).
+    /// Mesh or point file (.obj, .ply, .off, .xyz, optionally .gz), or a volume
+    /// (.nii, .nii.gz, .tif, .exr, .raw/.json, or a directory of slices).
     #[arg(value_name = "IN")]
     pub input: PathBuf,
     /// Print one JSON object instead of text.
@@ -28,6 +29,9 @@ pub struct InfoArgs {
 /// Runs `subdyn info`.
 pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     let path = &args.input;
+    if super::info_volume::is_volume(path) {
+        return super::info_volume::run(path, args.json);
+    }
     let format = MeshFormat::from_path(path)?;
     let bytes = std::fs::read(path).map_err(|e| subdyn::Error::io(path, e))?;
     let mesh = read_mesh_from_bytes(&bytes, format, path).map_err(|e| about_file(e, path))?;

@@ -8,6 +8,7 @@ mod common;
 mod compare;
 mod fit;
 mod info;
+mod info_volume;
 mod limit;
 mod mesh_stats;
 mod options;

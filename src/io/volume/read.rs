@@ -124,7 +124,7 @@ fn finish(
                 *v = (slope * f64::from(*v) + intercept) as f32;
             }
             notes.push(format!(
-                "intensity_scale from {} applied: value = {slope} × stored + {intercept}",
+                "intensity_scale from {} applied: value = {slope} × stored {intercept:+}",
                 file_name(&side.path)
             ));
         }

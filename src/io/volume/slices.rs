@@ -53,62 +53,79 @@ pub(crate) fn read_slice_dir(dir: &Path) -> Result<Decoded> {
         .zip(decoded)
         .flat_map(|(f, pages)| pages.into_iter().map(move |s| (f, s)))
         .collect();
-    let mut data = stack(&slices)?;
-    let notes: BTreeSet<String> = slices.iter().filter_map(|(_, s)| s.note.clone()).collect();
-    let (first_name, s0) = (&slices[0].0, &slices[0].1);
-    let dims = [s0.width, s0.height, slices.len()];
+    let stack = stacked(slices)?;
     let source = format!(
         "{} .{ext} slices ({}), {} to {}",
-        slices.len(),
-        s0.kind,
-        name(first_name),
-        name(files[files.len() - 1].as_path())
+        stack.dims[2],
+        stack.kind,
+        name(&files[0]),
+        name(&files[files.len() - 1])
     );
-    data.shrink_to_fit();
     Ok(Decoded {
-        dims,
-        data,
+        dims: stack.dims,
+        data: stack.data,
         placement: Placement::Grid { spacing: None },
         source,
-        notes: notes.into_iter().collect(),
+        notes: stack.notes,
         physical: false,
     })
 }
 
-/// Stacks the slices in order, checking that they agree in size and kind.
-pub(crate) fn stack(slices: &[(&PathBuf, Slice)]) -> Result<Vec<f32>> {
-    let (first, s0) = &slices[0];
-    let mut data = Vec::with_capacity(s0.samples.len() * slices.len());
+/// Slices stacked into one volume.
+pub(crate) struct Stacked {
+    /// Width, height, number of slices.
+    pub dims: [usize; 3],
+    /// The slices' common sample kind.
+    pub kind: String,
+    /// The slices' distinct notes.
+    pub notes: Vec<String>,
+    /// Samples, x fastest.
+    pub data: Vec<f32>,
+}
+
+/// Stacks the slices in order (freeing each once copied, so the peak memory
+/// stays near one volume), checking that they agree in size and kind.
+pub(crate) fn stacked(slices: Vec<(&PathBuf, Slice)>) -> Result<Stacked> {
+    let Some((first, s0)) = slices.first() else {
+        return Err(Error::Input("no slices to stack".into()));
+    };
+    let (first, width, height, kind) = ((*first).clone(), s0.width, s0.height, s0.kind.clone());
+    let depth = slices.len();
+    let mut data = Vec::with_capacity(width * height * depth);
+    let mut notes = BTreeSet::new();
     for (path, s) in slices {
-        if (s.width, s.height) != (s0.width, s0.height) {
+        if (s.width, s.height) != (width, height) {
             return Err(Error::parse(
                 path.as_path(),
                 0,
                 format!(
-                    "slice is {}×{} but {} is {}×{}: every slice must have the same size",
+                    "slice is {}×{} but {} is {width}×{height}: every slice must have the same size",
                     s.width,
                     s.height,
-                    name(first),
-                    s0.width,
-                    s0.height
+                    name(&first),
                 ),
             ));
         }
-        if s.kind != s0.kind {
+        if s.kind != kind {
             return Err(Error::parse(
                 path.as_path(),
                 0,
                 format!(
-                    "slice is {} but {} is {}: mixed bit depths",
+                    "slice is {} but {} is {kind}: mixed bit depths",
                     s.kind,
-                    name(first),
-                    s0.kind
+                    name(&first),
                 ),
             ));
         }
         data.extend_from_slice(&s.samples);
+        notes.extend(s.note);
     }
-    Ok(data)
+    Ok(Stacked {
+        dims: [width, height, depth],
+        kind,
+        notes: notes.into_iter().collect(),
+        data,
+    })
 }
 
 /// The slice files of `dir` sorted by the number in their names.

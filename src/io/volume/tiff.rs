@@ -10,32 +10,33 @@
 
 use std::fs::File;
 use std::io::BufReader;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use ::tiff::ColorType;
 use ::tiff::decoder::ifd::Value;
-use ::tiff::decoder::{Decoder, DecodingResult, Limits};
+use ::tiff::decoder::{Decoder, DecodingResult};
 use ::tiff::tags::Tag;
 
 use super::decoded::{Decoded, Placement};
-use super::slices::{Slice, name, stack};
+use super::slices::{Slice, name, stacked};
 use crate::error::{Error, Result};
 
 /// Reads a (multi-page) TIFF file as a volume.
 pub(crate) fn read_tiff_stack(path: &Path) -> Result<Decoded> {
     let (pages, spacing) = tiff_pages(path)?;
     let owned = path.to_path_buf();
-    let slices: Vec<(&PathBuf, Slice)> = pages.into_iter().map(|s| (&owned, s)).collect();
-    let data = stack(&slices)?;
-    let s0 = &slices[0].1;
-    let mut notes: Vec<String> = slices.iter().filter_map(|(_, s)| s.note.clone()).collect();
-    notes.dedup();
+    let stack = stacked(pages.into_iter().map(|s| (&owned, s)).collect())?;
     Ok(Decoded {
-        dims: [s0.width, s0.height, slices.len()],
-        data,
+        dims: stack.dims,
+        source: format!(
+            "TIFF, {} pages ({}), {}",
+            stack.dims[2],
+            stack.kind,
+            name(path)
+        ),
+        data: stack.data,
         placement: Placement::Grid { spacing },
-        source: format!("TIFF, {} pages ({}), {}", slices.len(), s0.kind, name(path)),
-        notes,
+        notes: stack.notes,
         physical: false,
     })
 }
@@ -44,9 +45,9 @@ pub(crate) fn read_tiff_stack(path: &Path) -> Result<Decoded> {
 pub(crate) fn tiff_pages(path: &Path) -> Result<(Vec<Slice>, Option<[f64; 3]>)> {
     let bad = |e: ::tiff::TiffError| Error::parse(path, 0, format!("cannot decode the TIFF: {e}"));
     let file = File::open(path).map_err(|e| Error::io(path, e))?;
-    let mut dec = Decoder::new(BufReader::new(file))
-        .map_err(bad)?
-        .with_limits(Limits::unlimited());
+    // The tiff crate's default limits (256 MiB per page) turn an absurd page
+    // size in a damaged header into an error instead of an allocation failure.
+    let mut dec = Decoder::new(BufReader::new(file)).map_err(bad)?;
     let spacing = imagej_spacing(&mut dec);
     let mut pages = Vec::new();
     loop {
