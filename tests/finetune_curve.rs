@@ -368,3 +368,121 @@ fn bad_input_is_one_clear_error() {
     let open_alpha = ScalarFunction::constant(&open, 1, 1.0).unwrap();
     assert!(CurveFinetune::new(&topo, &good, &open_alpha, &p).is_err());
 }
+
+// ---------------------------------------------------------------------------
+// The `subdyn finetune curve` verb.
+
+mod cli {
+    use std::path::Path;
+    use std::process::{Command, Output};
+
+    fn subdyn(dir: &Path, args: &[&str]) -> Output {
+        Command::new(env!("CARGO_BIN_EXE_subdyn"))
+            .args(args)
+            .current_dir(dir)
+            .output()
+            .expect("the subdyn binary runs")
+    }
+
+    const OCTAGON: &str = r#"{"scheme": "quadratic", "closed": true,
+        "points": [[0,0],[2,0],[3,1],[3,3],[2,4],[0,4],[-1,3],[-1,1]]}"#;
+    const VALUES: &str = r#"{"degree": 1, "values": [1.5, 1, 1, 1, 1, 1, 1, 1]}"#;
+
+    #[test]
+    fn finetune_curve_writes_the_curve_report_and_picture() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("c.json"), OCTAGON).unwrap();
+        std::fs::write(dir.path().join("v.json"), VALUES).unwrap();
+        let out = subdyn(
+            dir.path(),
+            &[
+                "finetune", "curve", "c.json", "--values", "v.json", "-o", "q.json", "--report",
+                "r.json", "--png", "q.png",
+            ],
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let q: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join("q.json")).unwrap())
+                .unwrap();
+        assert_eq!(q["degree"], 3);
+        assert_eq!(q["closed"], true);
+        let n = q["control_points"].as_array().unwrap().len();
+        assert_eq!(q["knots"].as_array().unwrap().len(), n + 4);
+        let r: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap())
+                .unwrap();
+        assert!(r["gap_after"].as_f64().unwrap() < 1e-8);
+        assert!(r["final_energy"].as_f64().unwrap() < r["initial_energy"].as_f64().unwrap());
+        assert!(std::fs::metadata(dir.path().join("q.png")).unwrap().len() > 1000);
+    }
+
+    #[test]
+    fn bad_curve_input_is_one_line_and_no_output() {
+        let cases: [(&str, &str, &str, &[&str]); 7] = [
+            (
+                "{\"scheme\": \"quadratic\",\n \"points\": [[0,0],[1,",
+                VALUES,
+                "c.json:2",
+                &[],
+            ),
+            (
+                r#"{"scheme": "quintic", "points": [[0,0],[1,0],[1,1]]}"#,
+                VALUES,
+                "quadratic",
+                &[],
+            ),
+            (
+                r#"{"scheme": "cubic", "closed": true, "points": [[0,0],[1,0]]}"#,
+                VALUES,
+                "control points",
+                &[],
+            ),
+            (
+                r#"{"scheme": "cubic", "points": [[0,0],[1,0,2,3],[1,1],[0,1]]}"#,
+                VALUES,
+                "point 1",
+                &[],
+            ),
+            (
+                OCTAGON,
+                r#"{"degree": 1, "values": [1, 1]}"#,
+                "expected 8",
+                &[],
+            ),
+            (
+                OCTAGON,
+                r#"{"degree": 1, "values": [1, 1, 1, -2, 1, 1, 1, 1]}"#,
+                "positive",
+                &[],
+            ),
+            (OCTAGON, VALUES, "--k", &["--k", "1,nan"]),
+        ];
+        for (curve, values, needle, extra) in cases {
+            let dir = tempfile::tempdir().unwrap();
+            std::fs::write(dir.path().join("c.json"), curve).unwrap();
+            std::fs::write(dir.path().join("v.json"), values).unwrap();
+            let mut args = vec![
+                "finetune", "curve", "c.json", "--values", "v.json", "-o", "q.json", "--png",
+                "q.png",
+            ];
+            args.extend_from_slice(extra);
+            let out = subdyn(dir.path(), &args);
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(1), "{needle}: {err}");
+            assert_eq!(err.lines().count(), 1, "{err}");
+            assert!(
+                err.starts_with("subdyn: error:") && err.contains(needle),
+                "{needle}: {err}"
+            );
+            let left: Vec<_> = std::fs::read_dir(dir.path())
+                .unwrap()
+                .map(|e| e.unwrap().file_name())
+                .collect();
+            assert_eq!(left.len(), 2, "{needle}: files left {left:?}");
+        }
+    }
+}

@@ -44,7 +44,7 @@ use super::curve_alpha::ScalarFunction;
 use super::curve_bspline::BSplineCurve;
 use super::curve_energy::SpringTargets;
 use super::curve_exact::{ExactFinetune, closed_spline, exact_finetune};
-use super::curve_frames::variable_frames;
+use super::curve_frames::leg_frames;
 use super::curve_solver::{Converging, History, STALLED, SpringProblem};
 
 /// Parameters of closed-curve fine tuning.
@@ -155,9 +155,9 @@ impl CurveFinetune {
         }
         let closed = if topology.closed {
             let identity = ScalarFunction::constant(topology, alpha.degree, 1.0)?;
-            let initial = exact_finetune(topology, points, &identity)?.periodic_points;
             let c = &exact.periodic_points;
             let n = c.len();
+            let initial = exact_finetune(topology, points, &identity)?.periodic_points;
             let scale = 1.0 / extent;
             let legs: Vec<Vector3> = (0..n)
                 .map(|j| {
@@ -177,7 +177,7 @@ impl CurveFinetune {
                 .iter()
                 .map(|p| Point3::from((p - lo) * scale))
                 .collect();
-            let (frames, start) = variable_frames(
+            let (legs, start) = leg_frames(
                 &scaled,
                 params.fixed_point,
                 planar,
@@ -185,8 +185,10 @@ impl CurveFinetune {
                 params.k_angle,
             )?;
             let problem = SpringProblem {
+                origin: scaled[params.fixed_point],
+                fixed: params.fixed_point,
+                legs,
                 num_vars: start.len(),
-                frames,
                 targets,
             };
             Some(ClosedSetup {

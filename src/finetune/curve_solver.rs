@@ -2,12 +2,9 @@
 //! (Polak-Ribière+, More-Thuente line search), over a reduced set of
 //! variables that fixes one point and one rotation.
 //!
-//! Every control point is `C_i = o_i + Σ_v x_v e_v` with its own origin and
-//! 0 to 3 basis vectors: the fixed point has none, the next point moves along
-//! the first leg's direction (fixes the rotation in the plane), in 3-D one
-//! more point moves in a half-plane through that axis (fixes the rotation
-//! about it), every other point moves freely (in the `z = const` plane for
-//! planar curves). The gradient in `x` is `e_v · ∂E/∂C_i`.
+//! The variables are the legs of the polygon walked from the fixed point
+//! (see `curve_frames`): `d_t = Σ_v x_v e_v`, `C` the prefix sums, so the
+//! gradient in `x` is `e_v · Σ_{s>t} ∂E/∂p_s` (suffix sums).
 //!
 //! argmin 0.11 stops only on iteration count or target cost, so the solver
 //! is wrapped in [`Converging`], which also stops when `|∇E| ≤ tolerance`,
@@ -27,20 +24,23 @@ use crate::math::{Point3, Real, Vector3};
 
 use super::curve_energy::SpringTargets;
 
-/// How one control point depends on the variables.
+/// How one leg depends on the variables: `d_t = Σ_v x_v e_v`.
 #[derive(Clone, Debug)]
-pub struct PointFrame {
-    /// `o_i`.
-    pub origin: Point3,
-    /// The `e_v` (0 to 3), each with the index of its variable.
+pub struct LegFrame {
+    /// The `e_v` (1 to 3), each with the index of its variable.
     pub axes: Vec<(usize, Vector3)>,
 }
 
-/// The energy over the reduced variables, as an argmin problem.
+/// The energy over the reduced variables (legs walked from the fixed point,
+/// see `curve_frames`), as an argmin problem.
 #[derive(Clone, Debug)]
 pub struct SpringProblem {
-    /// One frame per control point.
-    pub frames: Vec<PointFrame>,
+    /// The fixed control point `C_f`.
+    pub origin: Point3,
+    /// Its index `f`.
+    pub fixed: usize,
+    /// Frames of legs `d_0 … d_{N−2}` in walking order.
+    pub legs: Vec<LegFrame>,
     /// Number of variables.
     pub num_vars: usize,
     /// Targets and weights of energy (13).
@@ -48,23 +48,30 @@ pub struct SpringProblem {
 }
 
 impl SpringProblem {
-    /// Control points for variables `x`.
+    /// Control points `C_0 … C_{N−1}` for variables `x`.
     pub fn points(&self, x: &[Real]) -> Vec<Point3> {
-        self.frames
-            .iter()
-            .map(|f| f.axes.iter().fold(f.origin, |p, (v, e)| p + x[*v] * e))
-            .collect()
+        let n = self.legs.len() + 1;
+        let mut out = vec![self.origin; n];
+        let mut p = self.origin;
+        for (t, leg) in self.legs.iter().enumerate() {
+            p = leg.axes.iter().fold(p, |p, (v, e)| p + x[*v] * e);
+            out[(self.fixed + t + 1) % n] = p;
+        }
+        out
     }
 
-    /// Energy and gradient in the variables.
+    /// Energy and gradient in the variables: `∂E/∂d_t = Σ_{s>t} ∂E/∂p_s`.
     pub fn energy_gradient(&self, x: &[Real]) -> (Real, Vec<Real>) {
         let points = self.points(x);
-        let mut g = vec![Vector3::zeros(); points.len()];
+        let n = points.len();
+        let mut g = vec![Vector3::zeros(); n];
         let e = self.targets.energy(&points, Some(&mut g));
         let mut gx = vec![0.0; self.num_vars];
-        for (f, gi) in self.frames.iter().zip(&g) {
-            for (v, axis) in &f.axes {
-                gx[*v] += axis.dot(gi);
+        let mut suffix = Vector3::zeros();
+        for (t, leg) in self.legs.iter().enumerate().rev() {
+            suffix += g[(self.fixed + t + 1) % n];
+            for (v, axis) in &leg.axes {
+                gx[*v] += axis.dot(&suffix);
             }
         }
         (e, gx)
