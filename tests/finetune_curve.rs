@@ -299,6 +299,39 @@ fn stretched_leg_energy_decreases_and_the_curve_closes() {
 }
 
 #[test]
+fn a_non_planar_closed_curve_closes_too() {
+    let mut rng = Rng::new(19);
+    let topo = CurveTopology::new(CurveScheme::Cubic, 8, true).unwrap();
+    let pts: Vec<Point3> = ellipse(&mut rng, 8)
+        .iter()
+        .enumerate()
+        .map(|(i, p)| Point3::new(p.x, p.y, 0.5 * (TAU * i as f64 / 8.0).sin()))
+        .collect();
+    let mut values = vec![1.0; 8];
+    values[3] = 1.4;
+    let alpha = alpha_from_values(&topo, 1, &values).unwrap();
+    let tuner = CurveFinetune::new(&topo, &pts, &alpha, &CurveFinetuneParams::default()).unwrap();
+    let (curve, r) = tuner.solve().unwrap();
+    eprintln!(
+        "3-D: {} after {} iterations, |grad| {:.1e}",
+        r.termination, r.iterations, r.gradient_norm
+    );
+    assert!(
+        r.energies
+            .windows(2)
+            .all(|w| w[1] <= w[0] + 1e-15 * r.energies[0])
+    );
+    assert!(
+        r.final_energy < 0.5 * r.initial_energy && r.gradient_norm < 1e-6,
+        "{}",
+        r.termination
+    );
+    assert!(r.gap_before > 1e-3 && r.gap_after < 1e-8);
+    // The result really leaves the plane.
+    assert!(curve.samples(200).iter().any(|p| p.z.abs() > 0.1));
+}
+
+#[test]
 fn energy_gradient_matches_finite_differences() {
     let mut rng = Rng::new(21);
     for planar in [true, false] {

@@ -12,8 +12,8 @@
 //! **Output**: `{"degree", "closed", "knots", "control_points", "domain",
 //! "samples"}` — an ordinary B-spline (`N` control points, `N + degree + 1`
 //! knots, defined on `domain = [knots[degree], knots[N]]`); a closed curve
-//! repeats its first control points at the end so that the same formula
-//! traces it. `samples` are 20 points per unit of parameter, for plotting.
+//! starts with wrapped copies of its last few control points (`degree + 1 −
+//! m` of them, `m` the knot multiplicity), so the same formula traces it. `samples` are 20 points per unit of parameter, for plotting.
 
 use std::path::Path;
 
