@@ -17,8 +17,10 @@
 //! `atan2(|a × b|, a · b)` exists, with
 //! `∂θ/∂a = −(b̂ − cos θ â) / (|a| sin θ)` (and `a ↔ b`), not defined where
 //! the legs are parallel; the angle term's gradient is dropped where
-//! `sin θ < 1e-9` (its size there is at most `2 k_a |θ^opt − θ| / |a|`, which
-//! is below `2e-9 k_a / |a|` when `θ^opt = 0`).
+//! `sin θ < 1e-9` (its size there is at most `2 k_a |θ^opt − θ| / |a|`: tiny
+//! for a straight joint meant to stay straight, the common case at the
+//! multiple knots; a 3-D joint meant to bend but lying straight gets no
+//! push from this term).
 
 use std::f64::consts::{PI, TAU};
 
