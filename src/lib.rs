@@ -17,16 +17,18 @@
 //!
 //! Modules: [`math`] (scalar and point types), [`error`], [`mesh`] (polygon
 //! meshes, point clouds), [`io`] (OBJ, PLY, OFF, XYZ), [`topology`] (edges,
-//! adjacency, tags), [`subdivision`] (Catmull-Clark refinement), [`stencil`]
+//! adjacency, tags), [`subdivision`] (Catmull-Clark refinement, B-spline curves), [`stencil`]
 //! (CSR stencil tables), [`limit`] (limit masks, exact evaluation, closest point),
 //! [`metrics`] (point-to-mesh distances, Chamfer, Hausdorff), [`render`]
-//! (software rasteriser for pictures).
+//! (software rasteriser for pictures), [`finetune`] (fine tuning of curves by
+//! scaling derivatives).
 
 #![warn(missing_docs)]
 
 pub mod dynamics;
 pub mod error;
 pub mod examples;
+pub mod finetune;
 pub mod fit;
 pub mod forces;
 pub mod io;

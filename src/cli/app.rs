@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use super::{bench, common, compare, fit, info, limit, recover, render, subdivide};
+use super::{bench, common, compare, finetune, fit, info, limit, recover, render, subdivide};
 
 /// subdyn: Catmull-Clark subdivision surfaces — refinement as stencil tables,
 /// exact limit evaluation, mesh inspection and benchmarks.
@@ -38,6 +38,9 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Draw a mesh and/or point cloud to a PNG (software rasteriser).
     Render(render::RenderArgs),
+    /// Fine tuning by scaling derivatives: a new shape whose derivatives are the old ones scaled by α.
+    #[command(subcommand)]
+    Finetune(finetune::FinetuneCommand),
     /// Benchmarks (timings as a table, then one JSON line).
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -56,6 +59,7 @@ pub fn run() -> ExitCode {
         Command::Info(args) => info::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Render(args) => render::run(&args),
+        Command::Finetune(cmd) => finetune::run(&cmd),
         Command::Bench(cmd) => bench::run(&cmd),
     };
     match result {

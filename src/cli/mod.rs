@@ -6,6 +6,8 @@ mod bench_closest;
 mod bench_distance;
 mod common;
 mod compare;
+mod finetune;
+mod finetune_curve;
 mod fit;
 mod info;
 mod info_volume;

@@ -1,0 +1,58 @@
+//! Curve fine tuning end to end on a 100-leg closed quadratic curve (a wavy
+//! ring, linear α with one leg at 1.5): exact product and integral, spring
+//! setup and the NCG solve. Baseline in the same run: the exact open-curve
+//! fine tuning of the same polygon (no optimisation).
+//! Run with `cargo bench --bench finetune_curve`.
+
+use std::f64::consts::TAU;
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use subdyn::finetune::{CurveFinetuneParams, alpha_from_values, finetune_curve};
+use subdyn::math::Point3;
+use subdyn::subdivision::{CurveScheme, CurveTopology};
+
+fn ring(n: usize) -> Vec<Point3> {
+    (0..n)
+        .map(|i| {
+            let a = TAU * i as f64 / n as f64;
+            let r = 1.0 + 0.1 * (5.0 * a).sin();
+            Point3::new(r * a.cos(), r * a.sin(), 0.0)
+        })
+        .collect()
+}
+
+fn bench(c: &mut Criterion) {
+    let n = 100;
+    let points = ring(n);
+    let params = CurveFinetuneParams::default();
+    let closed = CurveTopology::new(CurveScheme::Quadratic, n, true).unwrap();
+    let mut values = vec![1.0; closed.num_legs()];
+    values[0] = 1.5;
+    let alpha = alpha_from_values(&closed, 1, &values).unwrap();
+    let (_, report) = finetune_curve(&closed, &points, &alpha, &params).unwrap();
+    eprintln!(
+        "closed 100 legs: {} iterations ({}), |grad| {:.1e}, energy {:.3e} -> {:.3e}, gap {:.3} -> {:.1e}",
+        report.iterations,
+        report.termination,
+        report.gradient_norm,
+        report.initial_energy,
+        report.final_energy,
+        report.gap_before,
+        report.gap_after
+    );
+    let open = CurveTopology::new(CurveScheme::Quadratic, n, false).unwrap();
+    let open_alpha = alpha_from_values(&open, 1, &values[..open.num_legs()]).unwrap();
+    let mut group = c.benchmark_group("finetune_curve");
+    group.sample_size(10);
+    group.bench_function("open_100_exact", |b| {
+        b.iter(|| finetune_curve(&open, black_box(&points), &open_alpha, &params).unwrap())
+    });
+    group.bench_function("closed_100_spring_ncg", |b| {
+        b.iter(|| finetune_curve(&closed, black_box(&points), &alpha, &params).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,169 @@
+//! `subdyn finetune curve CURVE.json --values V.json -o OUT.json`: the
+//! fine-tuned curve `Q' = α P'` (exact for open curves, closed again by the
+//! spring energy (13) for closed ones). File formats: `subdyn::finetune`'s
+//! `curve_io` module docs.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use serde_json::json;
+
+use subdyn::finetune::{
+    CurveFinetune, CurveFinetuneParams, CurveLayer, curve_json, curve_picture, read_alpha,
+    read_curve, write_json,
+};
+use subdyn::math::Real;
+use subdyn::render::{check_png_path, write_png};
+
+use super::common::{about_file, print_stdout, warn, write_report};
+
+/// Arguments of `subdyn finetune curve`.
+#[derive(Debug, Args)]
+#[command(
+    after_help = "CURVE.json: {\"scheme\": \"quadratic\"|\"cubic\", \"closed\": bool, \
+    \"points\": [[x,y] or [x,y,z], ...]}. V.json: {\"degree\": 1|2|3, \"values\": [...]}, one \
+    positive value per edge (leg i joins points i and i+1) or per vertex: quadratic curves take \
+    degree 1 and 3 on edges, 2 on vertices; cubic curves degree 1 and 3 on vertices, 2 on edges."
+)]
+pub struct CurveArgs {
+    /// The curve (JSON).
+    #[arg(value_name = "CURVE.json")]
+    pub input: PathBuf,
+    /// Control values of α (JSON).
+    #[arg(long, value_name = "V.json")]
+    pub values: PathBuf,
+    /// Output B-spline (JSON).
+    #[arg(short, long, value_name = "OUT.json")]
+    pub output: PathBuf,
+    /// Spring coefficients k_l,k_a of eq. 13 (closed curves).
+    #[arg(long, value_name = "KL,KA", default_value = "1,2")]
+    pub k: String,
+    /// Index of the fixed control point of the fine-tuned polygon (closed curves).
+    #[arg(long, value_name = "I", default_value_t = 0)]
+    pub fix: usize,
+    /// Write a JSON report (energies, iterations, gaps, time).
+    #[arg(long, value_name = "R.json")]
+    pub report: Option<PathBuf>,
+    /// Draw the original and the fine-tuned curve (top view) to a PNG.
+    #[arg(long, value_name = "P.png")]
+    pub png: Option<PathBuf>,
+    /// No summary on stdout and no warnings.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Parses `KL,KA`.
+fn spring_coefficients(text: &str) -> anyhow::Result<(Real, Real)> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let parse = |s: &str| {
+        s.parse::<Real>()
+            .ok()
+            .filter(|x| x.is_finite() && *x >= 0.0)
+    };
+    match parts.as_slice() {
+        [a, b] => match (parse(a), parse(b)) {
+            (Some(a), Some(b)) if a + b > 0.0 => Ok((a, b)),
+            _ => anyhow::bail!("--k {text}: expected two non-negative numbers, not both zero"),
+        },
+        _ => anyhow::bail!("--k {text}: expected KL,KA"),
+    }
+}
+
+/// Runs `subdyn finetune curve`.
+pub fn run(args: &CurveArgs) -> anyhow::Result<()> {
+    let (k_length, k_angle) = spring_coefficients(&args.k)?;
+    if let Some(png) = &args.png {
+        check_png_path(png)?;
+    }
+    let (topo, points) = read_curve(&args.input).map_err(|e| about_file(e, &args.input))?;
+    let alpha = read_alpha(&args.values, &topo).map_err(|e| about_file(e, &args.values))?;
+    let params = CurveFinetuneParams {
+        k_length,
+        k_angle,
+        fixed_point: args.fix,
+        ..CurveFinetuneParams::default()
+    };
+    let tuner = CurveFinetune::new(&topo, &points, &alpha, &params)?;
+    let (curve, report) = tuner.solve()?;
+    if !report.converged {
+        warn(
+            args.quiet,
+            &format!(
+                "the solver stopped before converging: {}",
+                report.termination
+            ),
+        );
+    }
+    write_json(&args.output, &curve_json(&curve, topo.closed))?;
+    if let Some(path) = &args.report {
+        write_report(
+            path,
+            &json!({
+                "input": args.input.display().to_string(),
+                "closed": topo.closed,
+                "curve_degree": topo.degree(),
+                "alpha_degree": alpha.degree,
+                "degree": report.degree,
+                "multiplicity": report.multiplicity,
+                "control_points": report.num_control_points,
+                "variables": report.num_variables,
+                "iterations": report.iterations,
+                "initial_energy": report.initial_energy,
+                "final_energy": report.final_energy,
+                "gradient_norm": report.gradient_norm,
+                "converged": report.converged,
+                "termination": report.termination,
+                "gap_before": report.gap_before,
+                "gap_after": report.gap_after,
+                "seconds": report.seconds,
+                "energies": report.energies,
+            }),
+        )?;
+    }
+    if let Some(path) = &args.png {
+        let spans = topo.num_spans();
+        let ts: Vec<Real> = (0..=20 * spans).map(|i| i as Real / 20.0).collect();
+        let original = topo.limit_stencil(&ts, 0)?.apply(&points)?;
+        let mut polygon = points.clone();
+        if topo.closed {
+            polygon.push(points[0]);
+        }
+        let (t0, t1) = curve.domain();
+        let layers = [
+            CurveLayer {
+                points: polygon,
+                color: [170, 170, 170],
+                width: 1,
+                marks: true,
+            },
+            CurveLayer {
+                points: original,
+                color: [60, 90, 200],
+                width: 3,
+                marks: false,
+            },
+            CurveLayer {
+                points: curve.samples(((t1 - t0) * 20.0).ceil() as usize),
+                color: [220, 60, 40],
+                width: 3,
+                marks: false,
+            },
+        ];
+        let picture = curve_picture(&layers, "blue: original  red: fine-tuned", 800, 600)?;
+        write_png(path, &picture)?;
+    }
+    if !args.quiet {
+        print_stdout(&format!(
+            "fine-tuned curve: degree {}, {} control points, {} iterations, energy {:.3e} -> {:.3e}, gap {:.1e} -> {:.1e}, {:.1} ms\n",
+            report.degree,
+            report.num_control_points,
+            report.iterations,
+            report.initial_energy,
+            report.final_energy,
+            report.gap_before,
+            report.gap_after,
+            report.seconds * 1e3
+        ))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,29 @@
+//! Fine tuning of subdivision curves by scaling derivatives (fine-tuning
+//! paper, §4.2): a new curve `Q` with `Q'(t) = α(t) P'(t)`, closed curves
+//! closed again by the spring energy (13) minimised with nonlinear CG.
+//!
+//! Curve files: `curve_alpha` (α from control values), `curve_exact` (exact
+//! product and integral as a B-spline), `curve_bspline` (evaluation),
+//! `curve_energy` (eq. 13), `curve_frames` (fixed point and rotation),
+//! `curve_solver` (argmin glue), `curve` (params, precompute, solve, report),
+//! `curve_io` (JSON files), `curve_picture` (top-view PNG).
+
+mod curve;
+mod curve_alpha;
+mod curve_bspline;
+mod curve_energy;
+mod curve_exact;
+mod curve_frames;
+mod curve_io;
+mod curve_picture;
+mod curve_solver;
+
+pub use curve::{CurveFinetune, CurveFinetuneParams, CurveFinetuneReport, finetune_curve};
+pub use curve_alpha::{ScalarFunction, ValuesOn, alpha_from_values, values_on};
+pub use curve_bspline::BSplineCurve;
+pub use curve_energy::{SpringTargets, joint_angle};
+pub use curve_exact::{
+    ExactFinetune, closed_spline, exact_finetune, finetuned_spans, spline_from_spans,
+};
+pub use curve_io::{curve_json, read_alpha, read_curve, write_json};
+pub use curve_picture::{CurveLayer, curve_picture};
