@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use super::{bench, common, compare, fit, info, limit, render, subdivide};
+use super::{bench, common, compare, finetune, fit, info, limit, render, subdivide};
 
 /// subdyn: Catmull-Clark subdivision surfaces — refinement as stencil tables,
 /// exact limit evaluation, mesh inspection and benchmarks.
@@ -39,6 +39,9 @@ enum Command {
     /// Benchmarks (timings as a table, then one JSON line).
     #[command(subcommand)]
     Bench(bench::BenchCommand),
+    /// Fine tuning by scaling derivatives (control values on edges).
+    #[command(subcommand)]
+    Finetune(finetune::FinetuneCommand),
 }
 
 /// Parses the command line, runs the verb and turns any error into one line
@@ -54,6 +57,7 @@ pub fn run() -> ExitCode {
         Command::Compare(args) => compare::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Bench(cmd) => bench::run(&cmd),
+        Command::Finetune(cmd) => finetune::run(&cmd),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,6 +6,8 @@ mod bench_closest;
 mod bench_distance;
 mod common;
 mod compare;
+mod finetune;
+mod finetune_surface;
 mod fit;
 mod info;
 mod limit;
@@ -14,5 +16,6 @@ mod options;
 mod progress;
 mod render;
 mod subdivide;
+mod subdivide_scheme;
 
 pub use app::run;
