@@ -35,8 +35,11 @@ pub struct SurfaceFineTuneParams {
     pub epsilon: Real,
     /// Most conjugate-gradient iterations; default 2000.
     pub max_iters: u64,
-    /// Stop when the gradient norm (unit-cube scale) is below this; default 1e-9.
+    /// Stop when the gradient norm (in the solver's Jacobi-scaled variables) is below this; default 1e-9.
     pub gradient_tolerance: Real,
+    /// Stop when the energy fell by less than this fraction over the last
+    /// 10 iterations; default 1e-5 (0 disables the rule).
+    pub energy_tolerance: Real,
     /// Pre-scale the mesh to the unit cube (and scale back); default true.
     pub prescale: bool,
 }
@@ -48,6 +51,7 @@ impl Default for SurfaceFineTuneParams {
             epsilon: 0.05,
             max_iters: 2000,
             gradient_tolerance: 1e-9,
+            energy_tolerance: 1e-5,
             prescale: true,
         }
     }
@@ -60,6 +64,8 @@ pub struct SurfaceFineTuneReport {
     pub iterations: u64,
     /// Energy before the first iteration and after each one (unit-cube scale).
     pub energies: Vec<Real>,
+    /// Gradient norm after each iteration (unit-cube scale).
+    pub gradient_norms: Vec<Real>,
     /// Why the solver stopped.
     pub termination: String,
     /// Number of edge loops, edge springs, loop joints, shape joints, free vertices.
@@ -97,7 +103,12 @@ fn check_params(p: &SurfaceFineTuneParams) -> Result<()> {
             p.k
         )));
     }
-    if !p.gradient_tolerance.is_finite() || p.gradient_tolerance < 0.0 || p.max_iters > 1_000_000 {
+    if !p.gradient_tolerance.is_finite()
+        || p.gradient_tolerance < 0.0
+        || !p.energy_tolerance.is_finite()
+        || p.energy_tolerance < 0.0
+        || p.max_iters > 1_000_000
+    {
         return Err(Error::Input(
             "gradient tolerance must be ≥ 0 and at most 1,000,000 iterations".into(),
         ));
@@ -235,6 +246,7 @@ impl SurfaceFineTune {
         let report = SurfaceFineTuneReport {
             iterations: run.iterations,
             energies: run.energies,
+            gradient_norms: run.gradient_norms,
             termination: run.termination,
             counts: self.counts,
             max_displacement,
