@@ -521,3 +521,69 @@ fn cli_subdivide_schemes() {
     );
     assert!(!d.join("y.obj").exists());
 }
+
+#[test]
+fn open_and_mixed_meshes_fine_tune_without_trouble() {
+    // An open 4×4 grid (boundary: open loops) and a pentagonal prism with two
+    // triangles (n-gons and triangles: approximate conversion).
+    let k = 4usize;
+    let positions: Vec<Point3> = (0..k * k)
+        .map(|v| Point3::new((v / k) as f64, (v % k) as f64, 0.1 * ((v * 7) % 5) as f64))
+        .collect();
+    let id = |i: usize, j: usize| (i * k + j) as u32;
+    let faces: Vec<Vec<u32>> = (0..k - 1)
+        .flat_map(|i| {
+            (0..k - 1).map(move |j| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
+        })
+        .collect();
+    let grid = subdyn::mesh::PolyMesh::from_faces(positions, &faces).unwrap();
+    let mut prism_faces = vec![vec![4, 3, 2, 1, 0], vec![5, 6, 7, 8, 9]];
+    for a in 0..5u32 {
+        let b = (a + 1) % 5;
+        if a == 2 {
+            prism_faces.push(vec![a, b, b + 5]);
+            prism_faces.push(vec![a, b + 5, a + 5]);
+        } else {
+            prism_faces.push(vec![a, b, b + 5, a + 5]);
+        }
+    }
+    let prism_positions: Vec<Point3> = (0..10)
+        .map(|v| {
+            let t = std::f64::consts::TAU * (v % 5) as f64 / 5.0;
+            Point3::new(t.cos(), t.sin(), if v < 5 { 0.0 } else { 1.2 })
+        })
+        .collect();
+    let prism = subdyn::mesh::PolyMesh::from_faces(prism_positions, &prism_faces).unwrap();
+    for (mesh, values, fixed) in [
+        (
+            grid,
+            vec![(id(1, 1), id(1, 2), 1.4), (id(2, 1), id(2, 2), 1.4)],
+            vec![0u32, 3, 12],
+        ),
+        (prism, vec![(5, 6, 1.3), (6, 7, 1.3)], vec![0, 1, 2]),
+    ] {
+        for scheme in [SurfaceScheme::DooSabin, SurfaceScheme::CatmullClark] {
+            let p = SurfaceFineTune::new(
+                &mesh,
+                scheme,
+                &values,
+                &fixed,
+                &SurfaceFineTuneParams::default(),
+            )
+            .unwrap();
+            let (out, report) = p.solve().unwrap();
+            let e = &report.energies;
+            assert!(e[0] > 0.0);
+            assert!(
+                e.windows(2).all(|w| w[1] <= w[0] * (1.0 + 1e-12)),
+                "energy rose"
+            );
+            assert!(*e.last().unwrap() < e[0]);
+            assert!(
+                out.positions
+                    .iter()
+                    .all(|q| q.coords.iter().all(|c| c.is_finite()))
+            );
+        }
+    }
+}
