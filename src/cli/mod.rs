@@ -8,6 +8,7 @@ mod common;
 mod compare;
 mod finetune;
 mod finetune_curve;
+mod finetune_surface;
 mod fit;
 mod info;
 mod info_volume;
@@ -18,5 +19,6 @@ mod progress;
 mod recover;
 mod render;
 mod subdivide;
+mod subdivide_scheme;
 
 pub use app::run;

@@ -16,6 +16,7 @@ use super::common::{
 };
 use super::options::{RefineArgs, read_polygon_mesh};
 use super::progress::Progress;
+use super::subdivide_scheme::{Scheme, refine_other};
 
 /// Most levels `subdivide` accepts (faces grow by 4× per level).
 pub const MAX_LEVELS: usize = 8;
@@ -34,9 +35,16 @@ pub struct SubdivideArgs {
     /// Number of uniform refinement levels (0 to 8).
     #[arg(short, long, default_value_t = 2)]
     pub levels: usize,
-    /// Move every output vertex to its position on the limit surface.
+    /// Move every output vertex to its position on the limit surface (Catmull-Clark only).
     #[arg(long)]
     pub limit: bool,
+    /// Subdivision scheme.
+    #[arg(long, value_enum, default_value_t = Scheme::CatmullClark)]
+    pub scheme: Scheme,
+    /// Knot intervals for `--scheme non-uniform`: lines `i j d` (edge between
+    /// vertices i and j gets interval d ≥ 0; unlisted edges get 1).
+    #[arg(long, value_name = "FILE")]
+    pub knots: Option<PathBuf>,
     #[command(flatten)]
     pub refine: RefineArgs,
     /// Write a JSON report (counts per level, timings, bounding box).
@@ -66,6 +74,9 @@ pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
     };
     let mesh = mesh?;
     check_size(&mesh, args.levels, &input_name)?;
+    if args.scheme != Scheme::CatmullClark {
+        return run_other(args, &mesh, &input_name);
+    }
 
     progress.stage("building the topology");
     let (refiner, topology_s) = timed(|| args.refine.refiner(&mesh, &input_name));
@@ -134,6 +145,37 @@ pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
         write_report(report, &value)?;
     }
     print_stdout(&summary)
+}
+
+/// `subdivide` with Doo-Sabin or non-uniform Catmull-Clark.
+fn run_other(args: &SubdivideArgs, mesh: &PolyMesh, input_name: &str) -> anyhow::Result<()> {
+    if args.limit {
+        anyhow::bail!("--limit is only available with --scheme catmull-clark");
+    }
+    let out = refine_other(mesh, args.scheme, args.levels, args.knots.as_ref())
+        .map_err(|e| e.context(input_name.to_string()))?;
+    write_mesh(&args.output, &out, None).map_err(|e| about_file(e, &args.output))?;
+    if let Some(report) = &args.report {
+        let value = json!({
+            "command": "subdivide",
+            "scheme": args.scheme.name(),
+            "input": input_name,
+            "output": args.output.display().to_string(),
+            "levels": args.levels,
+            "vertices": out.num_vertices(),
+            "faces": out.num_faces(),
+            "bbox": bbox_json(&out.positions),
+        });
+        write_report(report, &value)?;
+    }
+    print_stdout(&format!(
+        "subdivided {input_name} with {} to level {}: {} vertices, {} faces, written to {}\n",
+        args.scheme.name(),
+        args.levels,
+        thousands(out.num_vertices()),
+        thousands(out.num_faces()),
+        args.output.display()
+    ))
 }
 
 /// The input mesh and its name for messages: the file, or the embedded cube.

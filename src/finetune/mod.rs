@@ -1,13 +1,19 @@
-//! Fine tuning of subdivision curves by scaling derivatives (fine-tuning
-//! paper, §4.2): a new curve `Q` with `Q'(t) = α(t) P'(t)`, closed curves
-//! closed again by the spring energy (13) minimised with nonlinear CG.
+//! Fine tuning of subdivision curves and surfaces by scaling derivatives
+//! (fine-tuning paper, §4.2–4.4).
 //!
-//! Curve files: `curve_alpha` (α from control values), `curve_exact` (exact
-//! product and integral as a B-spline), `curve_bspline` (evaluation),
-//! `curve_energy` (eq. 13), `curve_frames` (fixed point and rotation),
-//! `curve_solver` (argmin glue), `curve` (params, precompute, solve, report),
-//! `curve_io` (JSON files), `curve_picture` (top-view PNG).
+//! Curves: a new curve `Q` with `Q'(t) = α(t) P'(t)`, closed curves closed
+//! again by the spring energy (13) minimised with nonlinear CG. Files:
+//! `curve_alpha` (α from control values), `curve_exact` (exact product and
+//! integral as a B-spline), `curve_bspline` (evaluation), `curve_energy`
+//! (eq. 13), `curve_frames` (fixed point and rotation), `curve_solver` (argmin
+//! glue), `curve` (params, precompute, solve, report), `curve_io` (JSON
+//! files), `curve_picture` (top-view PNG).
+//!
+//! Surfaces: Doo-Sabin to non-uniform Catmull-Clark conversion (`convert`),
+//! edge loops, the spring energy (14) (`surface_energy`, `surface_targets`)
+//! minimised by nonlinear conjugate gradient (`surface_solve`, `surface`).
 
+mod convert;
 mod curve;
 mod curve_alpha;
 mod curve_bspline;
@@ -17,7 +23,13 @@ mod curve_frames;
 mod curve_io;
 mod curve_picture;
 mod curve_solver;
+mod edge_loops;
+mod surface;
+mod surface_energy;
+mod surface_solve;
+mod surface_targets;
 
+pub use convert::{Conversion, ConvertedEdge, conversion_weight, doo_sabin_to_non_uniform};
 pub use curve::{CurveFinetune, CurveFinetuneParams, CurveFinetuneReport, finetune_curve};
 pub use curve_alpha::{ScalarFunction, ValuesOn, alpha_from_values, values_on};
 pub use curve_bspline::BSplineCurve;
@@ -27,3 +39,7 @@ pub use curve_exact::{
 };
 pub use curve_io::{curve_json, read_alpha, read_curve, write_json};
 pub use curve_picture::{CurveLayer, curve_picture};
+pub use edge_loops::{EdgeLoop, edge_loops};
+pub use surface::{SurfaceFineTune, SurfaceFineTuneParams, SurfaceFineTuneReport, SurfaceScheme};
+pub use surface_energy::{SpringEnergy, angle_and_gradients, joint_angles};
+pub use surface_targets::{LegKind, loop_targets};

@@ -1,13 +1,20 @@
-//! Uniform Catmull-Clark refinement: topology refined once, every level a
-//! stencil table `P_{k+1} = S_k P_k`; uniform quadratic / cubic B-spline
-//! subdivision curves (`curves`).
+//! Refinement as stencil tables: uniform Catmull-Clark (`P_{k+1} = S_k P_k`),
+//! Doo-Sabin, non-uniform Catmull-Clark with knot intervals, and uniform
+//! quadratic / cubic B-spline subdivision curves (`curves`).
 
 mod catmull_clark;
 mod curves;
+mod doo_sabin;
+mod non_uniform;
 mod refine_topology;
 mod refiner;
 
 pub use catmull_clark::refine_stencil;
 pub use curves::{CurveScheme, CurveTopology, bernstein, bspline_to_bezier, span_basis};
+pub use doo_sabin::{
+    DooSabinHierarchy, DooSabinStep, doo_sabin_faces, doo_sabin_refine, doo_sabin_step,
+    doo_sabin_weight,
+};
+pub use non_uniform::{NonUniformHierarchy, check_intervals, non_uniform_step};
 pub use refine_topology::refine_topology;
 pub use refiner::{BoundaryRule, Hierarchy, RefineOptions, Refiner};
