@@ -1,4 +1,7 @@
-//! Recovering shapes from volumes: analytic volumes with known surfaces.
+//! Recovering shapes from volumes: analytic volumes with known surfaces,
+//! the `recover` verb end to end, and its bad inputs.
+
+mod common;
 
 use subdyn::fit::recover::{
     RecoverParams, component_cage, prepare_volume, recover_shape, seed_cage,
@@ -95,4 +98,107 @@ fn a_torus_is_recovered_from_its_thresholded_component_with_edges() {
         out.report.stop_reason
     );
     assert!(mean < 0.3 && max < 1.5, "mean {mean} max {max}");
+}
+
+/// Writes `vol` as `dir/NAME.raw` (f32 little-endian) with its JSON header.
+fn write_raw(dir: &std::path::Path, name: &str, vol: &Volume) -> std::path::PathBuf {
+    let bytes: Vec<u8> = vol.data().iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(dir.join(format!("{name}.raw")), bytes).unwrap();
+    let o = vol.origin();
+    let header = serde_json::json!({
+        "dims": vol.dims(), "spacing": vol.spacing(), "origin": [o.x, o.y, o.z],
+        "dtype": "f32", "byte_order": "little", "header_bytes": 0,
+    });
+    std::fs::write(dir.join(format!("{name}.json")), header.to_string()).unwrap();
+    dir.join(format!("{name}.raw"))
+}
+
+#[test]
+fn the_recover_verb_writes_the_shape_report_and_slices_and_rejects_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = Point3::new(16.0, 16.0, 16.0);
+    let sdf = move |p: Point3| (p - c).norm() - 9.0;
+    let path = write_raw(dir.path(), "ball", &sdf_volume([32, 32, 32], [1.0; 3], sdf));
+    let out = common::run_subdyn(
+        dir.path(),
+        &[
+            "recover",
+            path.to_str().unwrap(),
+            "--seed",
+            "15,16,17",
+            "--iso",
+            "0.5",
+            "-o",
+            "ball.obj",
+            "--limit-out",
+            "ball.ply",
+            "--report",
+            "r.json",
+            "--slices-png",
+            "slices",
+            "--quiet",
+        ],
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("tolerance met"), "{text}");
+    let fit = subdyn::io::read_mesh(dir.path().join("ball.obj")).unwrap();
+    let (max, _) = surface_error(&fit, sdf);
+    assert!(max < 0.5, "largest distance {max} voxels");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    assert_eq!(report["init"]["method"], "seed");
+    assert!(
+        report["recover"]["levels"][0]["offsets"]["p95"]
+            .as_f64()
+            .unwrap()
+            < 0.5
+    );
+    assert_eq!(
+        std::fs::read_dir(dir.path().join("slices"))
+            .unwrap()
+            .count(),
+        5
+    );
+
+    // Bad inputs: one line, exit 1, no output file.
+    let flat = write_raw(
+        dir.path(),
+        "flat",
+        &sdf_volume([8, 8, 8], [1.0; 3], |_| 5.0),
+    );
+    let flat = flat.to_str().unwrap();
+    let path = path.to_str().unwrap();
+    for (args, expect) in [
+        (
+            vec!["recover", path, "--seed", "100,0,0", "--iso", "0.5"],
+            "outside the volume",
+        ),
+        (
+            vec!["recover", path, "--seed", "1,1,1", "--iso", "0.5"],
+            "not inside the object",
+        ),
+        (
+            vec!["recover", path, "--iso", "7"],
+            "outside the volume's range",
+        ),
+        (vec!["recover", flat], "constant"),
+        (vec!["recover", path, "--tol=-1"], "tolerance"),
+        (vec!["recover", "missing.nii"], "missing.nii"),
+    ] {
+        let mut args = args.clone();
+        args.extend(["-o", "bad.obj", "--quiet"]);
+        let out = common::run_subdyn(dir.path(), &args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains(expect) && err.lines().count() == 1,
+            "{args:?}: {err}"
+        );
+        assert!(!dir.path().join("bad.obj").exists());
+    }
 }

@@ -483,3 +483,15 @@ pub fn random_param(rng: &mut Rng, n: usize, margin: f64) -> (f64, f64) {
         )
     }
 }
+
+// ---------------------------------------------------------------------------
+// The binary
+
+/// Runs the `subdyn` binary with `args` in `dir`.
+pub fn run_subdyn(dir: &Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_subdyn"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the subdyn binary runs")
+}
