@@ -58,7 +58,12 @@ pub fn prepare_volume(volume: &Volume, params: &RecoverParams) -> Result<Prepare
             "the volume is constant ({lo}): there is no boundary to recover"
         )));
     }
-    let sigma = params.sigma.unwrap_or(volume.voxel_size());
+    let sigma = params.sigma.unwrap_or(
+        match params.boundary {
+            BoundaryModel::Iso { .. } => 0.5,
+            BoundaryModel::Edge { .. } => 1.0,
+        } * volume.voxel_size(),
+    );
     let t = Instant::now();
     let smoothed = gaussian_smoothed(volume, sigma)?;
     let smoothing_seconds = t.elapsed().as_secs_f64();

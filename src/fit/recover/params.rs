@@ -11,8 +11,10 @@ pub struct RecoverParams {
     /// What marks the boundary (default: the edge potential with
     /// `min_strength` 0.1; use [`BoundaryModel::Iso`] when the iso-value is known).
     pub boundary: BoundaryModel,
-    /// Gaussian smoothing σ in world units before edges are taken (default
-    /// `None`: one voxel).
+    /// Gaussian smoothing σ in world units (default `None`: half a voxel
+    /// for an iso-surface, one voxel for edges). Blur moves a curved
+    /// iso-surface inward by about `σ² κ / 2` (κ the mean curvature), so an
+    /// iso-surface gets only enough to tame voxel noise; edges need more.
     pub sigma: Option<Real>,
     /// The object is brighter than its surroundings (default true).
     pub bright_inside: bool,
