@@ -21,8 +21,13 @@ One command (from anywhere; needs target/release/subdyn and target/release/data-
 5. measures every surface against BASE.truth.obj with the same code
    (`subdyn compare SURF TRUTH --report C.json`): Chamfer and Hausdorff in
    voxels (÷ the smallest spacing) and in % of the truth's bounding-box diagonal;
-6. prints a Markdown table and writes recover_vs_marching_cubes.json (and .md)
-   beside this script.
+6. prints the Markdown tables (the section "Volume recovery vs marching cubes"
+   of RESULTS.md is built from them) and writes every figure to
+   recover_vs_marching_cubes.json beside this script.
+
+Options: --repeat N (timed runs per method, median reported; default 3),
+--keep DIR (keep volumes, meshes and compare reports there instead of a
+temporary directory), --subdyn / --data-gen (binaries), --out DIR.
 
 A comparison beside the product, never a dependency of it; not part of CI.
 Standard library only outside the venv.
@@ -130,6 +135,96 @@ def obj_vertex_count(path: Path) -> int:
         return sum(1 for line in f if line.startswith("v "))
 
 
+def read_ply(path: Path):
+    """Vertex positions and faces of a binary little-endian PLY (faces of one size only)."""
+    import numpy as np
+
+    data = path.read_bytes()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode("ascii").splitlines()
+    assert header[1].startswith("format binary_little_endian"), header[1]
+    types = {"double": "<f8", "float": "<f4", "float64": "<f8", "float32": "<f4"}
+    nv = nf = 0
+    props, elem = [], None
+    for line in header:
+        w = line.split()
+        if w[0] == "element":
+            elem = w[1]
+            if elem == "vertex":
+                nv = int(w[2])
+            elif elem == "face":
+                nf = int(w[2])
+        elif w[0] == "property" and elem == "vertex":
+            props.append((w[2], types[w[1]]))
+        elif w[0] == "property" and elem == "face":
+            assert w[1:4] == ["list", "uchar", "int"], line
+    vdt = np.dtype(props)
+    v = np.frombuffer(data, dtype=vdt, count=nv, offset=end)
+    verts = np.stack([v["x"], v["y"], v["z"]], axis=1).astype(float)
+    off = end + nv * vdt.itemsize
+    k = data[off]
+    fdt = np.dtype([("n", "u1"), ("i", "<i4", (k,))])
+    f = np.frombuffer(data, dtype=fdt, count=nf, offset=off)
+    assert (f["n"] == k).all(), "mixed face sizes"
+    return verts, f["i"].astype(np.int64)
+
+
+def signed_distance_fn(side: dict):
+    """The analytic signed distance (+ outside) of the generator's shape, from the sidecar, or None.
+
+    sphere |p| − r; torus about z √((√(x²+y²) − R)² + z²) − r; genus2 the smooth union of two such
+    tori (its sidecar formula, an approximate signed distance: exact away from the blend).
+    """
+    import numpy as np
+
+    a = side.get("truth", {}).get("analytic", {})
+    shape = side.get("shape")
+    if shape == "sphere":
+        c, r = np.array(a["centre"]), a["radius"]
+        return lambda p: np.linalg.norm(p - c, axis=1) - r
+    if shape == "torus" and a.get("axis") == [0.0, 0.0, 1.0]:
+        R, r = a["major_radius"], a["minor_radius"]
+        return lambda p: np.hypot(np.hypot(p[:, 0], p[:, 1]) - R, p[:, 2]) - r
+    if shape == "genus2" and "c = 1.1, R = 1, r = 0.4, k = 0.1" in a.get("implicit", ""):
+        c, R, r, k = 1.1, 1.0, 0.4, 0.1
+
+        def f(p):
+            t1 = np.hypot(np.hypot(p[:, 0] - c, p[:, 1]) - R, p[:, 2]) - r
+            t2 = np.hypot(np.hypot(p[:, 0] + c, p[:, 1]) - R, p[:, 2]) - r
+            m = np.minimum(t1, t2)
+            return m - k * np.log(np.exp(-(t1 - m) / k) + np.exp(-(t2 - m) / k))
+
+        return f
+    return None
+
+
+def mean_signed_offset(path: Path, sdf) -> float:
+    """Area-weighted mean of the analytic signed distance over a mesh (vertex areas: ⅓ of the
+    incident triangles' areas; polygons fanned into triangles)."""
+    import numpy as np
+
+    verts, faces = read_ply(path)
+    w = np.zeros(len(verts))
+    for j in range(1, faces.shape[1] - 1):
+        a, b, c = verts[faces[:, 0]], verts[faces[:, j]], verts[faces[:, j + 1]]
+        area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+        for idx in (faces[:, 0], faces[:, j], faces[:, j + 1]):
+            np.add.at(w, idx, area / 3.0)
+    return float((w * sdf(verts)).sum() / w.sum())
+
+
+def median_wall(fn, repeat: int):
+    """Run fn() repeat times; its first result and the median and all wall times."""
+    times, first = [], None
+    for i in range(repeat):
+        t0 = time.perf_counter()
+        res = fn()
+        times.append(time.perf_counter() - t0)
+        if i == 0:
+            first = res
+    return first, statistics.median(times), times
+
+
 # --------------------------------------------------------------------------- methods
 
 
@@ -176,6 +271,7 @@ def subdyn_recover(subdyn: Path, base: Path, iso: float, work: Path) -> dict:
     run(cmd, capture_output=True)
     wall = time.perf_counter() - t0
     report = json.loads(rep.read_text())
+    fit_sha = hashlib.sha256(fit.read_bytes()).hexdigest()[:16]
     levels = report["recover"]["levels"]
     return {
         "command": " ".join(str(c) for c in
@@ -183,6 +279,7 @@ def subdyn_recover(subdyn: Path, base: Path, iso: float, work: Path) -> dict:
                              "--limit-out", surf.name, "--report", rep.name, "--quiet"]),
         "fit": fit,
         "surf": surf,
+        "fit_sha": fit_sha,
         "seconds": wall,
         "control_points": obj_vertex_count(fit),
         "control_points_per_level": [lv["control_points"] for lv in levels],
@@ -213,6 +310,7 @@ def main() -> None:
     ap.add_argument("--data-gen", type=Path, default=ROOT / "target" / "release" / "data-gen")
     ap.add_argument("--out", type=Path, default=HERE, help="where the .json and .md go")
     ap.add_argument("--keep", type=Path, default=None, help="keep volumes and outputs in this directory")
+    ap.add_argument("--repeat", type=int, default=3, help="timed runs per method (median reported)")
     ap.add_argument("--upgrade", action="store_true", help="reinstall the venv packages")
     args = ap.parse_args()
     ensure_venv(args)
@@ -227,7 +325,8 @@ def main() -> None:
 
     git = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
     commit = git.stdout.strip() or "unknown"
-    dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no"],
+    dirty = subprocess.run(["git", "-C", ROOT, "status", "--porcelain", "--untracked-files=no",
+                            "--", ".", ":!benches/compare"],
                            capture_output=True, text=True).stdout.strip()
     if dirty:
         commit += "-dirty"
@@ -282,6 +381,7 @@ def main() -> None:
         diag = float(side["truth"]["bounding_box"]["diagonal"])
         truth_chord = side["truth"].get("max_face_centroid_distance_to_analytic_surface")
 
+        sdf = signed_distance_fn(side)
         rows = []
 
         def measured(method, surf, extra, limit_a=False, tag=""):
@@ -295,6 +395,8 @@ def main() -> None:
                 chamfer_pct=rep["chamfer_pct"],
                 hausdorff_pct=rep["hausdorff_pct"],
                 measured_vertices=rep["a"]["vertices"],
+                mean_signed_offset_vox=(mean_signed_offset(surf, sdf) / voxel
+                                        if sdf is not None and surf.suffix == ".ply" else None),
                 **extra,
             )
 
@@ -302,12 +404,18 @@ def main() -> None:
             tag = "mc_smooth" if smooth else "mc"
             out = work / f"{name}.{tag}.ply"
             log(f"{name}: marching cubes{' on the 1-voxel-smoothed volume' if smooth else ''}")
-            mc = marching_cubes(side, base, out, smooth)
+            mc, med, times = median_wall(lambda: marching_cubes(side, base, out, smooth), args.repeat)
+            mc["seconds"], mc["seconds_all"] = med, times
             label = "marching cubes, σ = 1 voxel smoothing" if smooth else "marching cubes, raw volume"
             rows.append(measured(label, out, dict(kind=tag, **mc), tag=tag))
 
         log(f"{name}: subdyn recover")
-        sd = subdyn_recover(args.subdyn, base, iso, work)
+        runs = [subdyn_recover(args.subdyn, base, iso, work) for _ in range(args.repeat)]
+        sd = runs[-1]  # its files are the ones on disk
+        sd["seconds_all"] = [r["seconds"] for r in runs]
+        sd["seconds"] = statistics.median(sd["seconds_all"])
+        sd["fit_obj_sha256_16_per_run"] = [r.pop("fit_sha") for r in runs]
+        sd["identical_across_runs"] = len(set(sd["fit_obj_sha256_16_per_run"])) == 1
         fit, surf = sd.pop("fit"), sd.pop("surf")
         row = measured("subdyn recover (limit tessellation, K = 4)", surf, dict(kind="subdyn", **sd), tag="subdyn")
         row["limit_vertices"] = row["measured_vertices"]
@@ -346,8 +454,9 @@ def main() -> None:
                   "voxels": "distance / smallest spacing of the volume",
                   "pct": "% of the ground truth's bounding-box diagonal",
                   "vertices": "marching cubes: mesh vertices; subdyn: control points of fit.obj",
-                  "seconds_mc": "read raw + (smoothing) + marching_cubes + write PLY, in Python",
-                  "seconds_subdyn": "wall clock of the whole `subdyn recover` process (read, smooth, init, fit, write fit.obj + surf.ply + report)",
+                  "mean_signed_offset_vox": "area-weighted mean of the shape's analytic signed distance (+ outside) over the measured tessellation, in voxels (genus2: its smooth-union formula, approximate near the blend); not for --limit-a rows",
+                  "seconds_mc": "median over --repeat runs of: read raw + (smoothing) + marching_cubes + write PLY, in Python",
+                  "seconds_subdyn": "median over --repeat runs of the wall clock of the whole `subdyn recover` process (read, smooth, init, fit, write fit.obj + surf.ply + report)",
               }}
     (args.out / "recover_vs_marching_cubes.json").write_text(json.dumps(result, indent=2) + "\n")
 
@@ -366,8 +475,8 @@ def main() -> None:
         md.append("")
         md.append(f"Volume: `{s['command']}`, iso-value {s['iso_value']}.")
         md.append("")
-        md.append("| method | vertices / control points | Chamfer (voxels) | Hausdorff (voxels) | Chamfer % diag | Hausdorff % diag | seconds |")
-        md.append("|---|---:|---:|---:|---:|---:|---:|")
+        md.append("| method | vertices / control points | Chamfer (voxels) | Hausdorff (voxels) | Chamfer % diag | Hausdorff % diag | mean signed offset (voxels) | seconds (median of " + str(args.repeat) + ") |")
+        md.append("|---|---:|---:|---:|---:|---:|---:|---:|")
         for r in s["rows"]:
             if r["kind"] == "subdyn":
                 v = f"{fmt_int(r['vertices'])} control points ({fmt_int(r['limit_vertices'])} limit-mesh vertices)"
@@ -375,9 +484,10 @@ def main() -> None:
                 v = f"{fmt_int(r['vertices'])} control points"
             else:
                 v = fmt_int(r["vertices"])
+            so = "—" if r["mean_signed_offset_vox"] is None else f"{r['mean_signed_offset_vox']:+.4f}"
             secs = f"{r['seconds']:.2f}" if r["kind"] != "subdyn_exact" else "(same run)"
             md.append(f"| {r['method']} | {v} | {r['chamfer_vox']:.4f} | {r['hausdorff_vox']:.3f} | "
-                      f"{r['chamfer_pct']:.4f} | {r['hausdorff_pct']:.3f} | {secs} |")
+                      f"{r['chamfer_pct']:.4f} | {r['hausdorff_pct']:.3f} | {so} | {secs} |")
         md.append("")
         parts = []
         for kind, label in (("mc", "raw marching cubes"), ("mc_smooth", "smoothed marching cubes")):
@@ -388,10 +498,13 @@ def main() -> None:
                 f"(subdyn/MC = {v['chamfer_ratio_subdyn_over_mc']:.2f}), MC has {v['vertex_ratio']:.1f}× "
                 f"subdyn's control points ({'≥ 10×' if v['vertices_at_most_one_tenth'] else '< 10×'}) → "
                 f"**{'yes' if ok else 'no'}**")
+        subrow = next(r for r in s["rows"] if r["kind"] == "subdyn")
+        if not subrow["identical_across_runs"]:
+            md.append(f"Note: the {args.repeat} subdyn runs wrote different fit.obj files; the last run is measured.")
+            md.append("")
         md.append("Equal or better Chamfer with at most one tenth of the vertices? " + "; ".join(parts) + ".")
         md.append("")
     text = "\n".join(md)
-    (args.out / "recover_vs_marching_cubes.md").write_text(text + "\n")
     print(text)
 
 
