@@ -41,6 +41,9 @@ pub enum BenchCommand {
     /// Exact point-to-triangle-mesh distances (BVH) against brute force;
     /// the last stdout line is one JSON object.
     Distance(super::bench_distance::BenchDistanceArgs),
+    /// Recovering a torus from a synthetic N³ volume, stage by stage, with
+    /// peak memory; the last stdout line is one JSON object.
+    Recover(super::bench_recover::BenchRecoverArgs),
 }
 
 /// Arguments of `subdyn bench subdivide`.
@@ -80,6 +83,7 @@ pub fn run(cmd: &BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Subdivide(args) => bench_subdivide(args),
         BenchCommand::Closest(args) => super::bench_closest::bench_closest(args),
         BenchCommand::Distance(args) => super::bench_distance::bench_distance(args),
+        BenchCommand::Recover(args) => super::bench_recover::bench_recover(args),
     }
 }
 

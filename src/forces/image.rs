@@ -52,6 +52,9 @@ pub struct ImageField<'a> {
     pub inside_level: Real,
     /// The object is brighter than its surroundings.
     pub bright_inside: bool,
+    /// Highest minus lowest intensity of `smoothed` (sets the scale below
+    /// which a gradient is too weak to follow).
+    pub contrast: Real,
 }
 
 /// Fraction of the smoothed volume's intensity range per voxel below which
@@ -65,11 +68,10 @@ impl ImageField<'_> {
     /// clear, else along `±n`. Following the image rather than the normal
     /// keeps parts of the surface whose normal has turned from running away.
     pub fn balloon_direction(&self, x: &Point3, n: &Vector3, inside: bool) -> Vector3 {
-        let (lo, hi) = self.smoothed.range();
         let g = self.smoothed.gradient(x);
         let outward = if self.bright_inside { -g } else { g };
         let len = outward.norm();
-        let dir = if len * self.smoothed.voxel_size() > WEAK_GRADIENT * (hi - lo) as Real {
+        let dir = if len * self.smoothed.voxel_size() > WEAK_GRADIENT * self.contrast {
             outward / len
         } else {
             *n

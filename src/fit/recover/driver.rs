@@ -119,6 +119,10 @@ pub fn recover_shape(
         model: params.boundary,
         inside_level: prepared.inside_level,
         bright_inside: params.bright_inside,
+        contrast: {
+            let (lo, hi) = prepared.smoothed.range();
+            (hi - lo) as Real
+        },
     };
     let voxel = prepared.smoothed.voxel_size();
     let mut mesh = init.clone();
