@@ -30,6 +30,7 @@ pub mod examples;
 pub mod fit;
 pub mod forces;
 pub mod io;
+pub mod lattice;
 pub mod limit;
 pub mod math;
 pub mod mesh;

@@ -483,3 +483,5 @@ pub fn random_param(rng: &mut Rng, n: usize, margin: f64) -> (f64, f64) {
         )
     }
 }
+
+pub mod volume;
