@@ -27,6 +27,7 @@
 pub mod dynamics;
 pub mod error;
 pub mod examples;
+pub mod ffd;
 pub mod fit;
 pub mod forces;
 pub mod io;
