@@ -225,3 +225,220 @@ fn bad_inputs_are_refused() {
     nan[2].z = f64::INFINITY;
     assert!(ffd.deform(&nan).is_err());
 }
+
+// ---------------------------------------------------------------- CLI
+
+mod cli {
+    use std::path::Path;
+    use std::process::{Command, Output};
+
+    use subdyn::ffd::{Ffd, FfdParams};
+    use subdyn::io::write_lattice;
+    use subdyn::lattice::box_grid;
+    use subdyn::math::Point3;
+
+    fn subdyn(dir: &Path, args: &[&str]) -> Output {
+        Command::new(env!("CARGO_BIN_EXE_subdyn"))
+            .args(args)
+            .current_dir(dir)
+            .output()
+            .expect("the subdyn binary runs")
+    }
+
+    fn stderr(out: &Output) -> String {
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    }
+
+    /// Exit 1, one `subdyn: error:` line holding `needle`, no output file.
+    fn assert_clean_failure(dir: &Path, out: &Output, needle: &str) {
+        let err = stderr(out);
+        assert_eq!(out.status.code(), Some(1), "stderr: {err}");
+        assert_eq!(err.lines().count(), 1, "one line expected: {err}");
+        assert!(
+            err.starts_with("subdyn: error: ") && !err.contains("panicked"),
+            "{err}"
+        );
+        assert!(
+            err.to_lowercase().contains(&needle.to_lowercase()),
+            "`{needle}` not in: {err}"
+        );
+        assert!(!dir.join("out.obj").exists(), "output written on failure");
+        let temp = std::fs::read_dir(dir)
+            .unwrap()
+            .any(|e| e.unwrap().file_name().to_string_lossy().contains(".tmp."));
+        assert!(!temp, "temporary file left behind");
+    }
+
+    /// A cube of side 0.6 centred in the unit cube, plus one vertex outside.
+    const MODEL: &str = "v 0.2 0.2 0.2\nv 0.8 0.2 0.2\nv 0.8 0.8 0.2\nv 0.2 0.8 0.2\n\
+v 0.2 0.2 0.8\nv 0.8 0.2 0.8\nv 0.8 0.8 0.8\nv 0.2 0.8 0.8\nv 3 3 3\n\
+f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\nf 9 1 2\n";
+
+    fn obj_vertices(path: &Path) -> Vec<Point3> {
+        std::fs::read_to_string(path)
+            .unwrap()
+            .lines()
+            .filter_map(|l| l.strip_prefix("v "))
+            .map(|l| {
+                let c: Vec<f64> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+                Point3::new(c[0], c[1], c[2])
+            })
+            .collect()
+    }
+
+    #[test]
+    fn ffd_with_moves_and_with_a_deformed_lattice() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::write(d.join("model.obj"), MODEL).unwrap();
+        let lat = box_grid(Point3::origin(), Point3::new(1.0, 1.0, 1.0), [2, 2, 2]).unwrap();
+        write_lattice(d.join("lat.json"), &lat).unwrap();
+        let top = lat.num_vertices() - 1;
+        std::fs::write(
+            d.join("moves.json"),
+            format!("{{\"moves\": [{{\"vertex\": {top}, \"offset\": [0, 0, 0.5]}}]}}"),
+        )
+        .unwrap();
+        let out = subdyn(
+            d,
+            &[
+                "ffd",
+                "model.obj",
+                "--lattice",
+                "lat.json",
+                "--moves",
+                "moves.json",
+                "--levels",
+                "2",
+                "-o",
+                "out.obj",
+                "--report",
+                "r.json",
+                "--quiet",
+            ],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("r.json")).unwrap()).unwrap();
+        assert_eq!(report["ffd"]["outside"], 1);
+        assert_eq!(report["ffd"]["embedded"], 8);
+        // Same as the library.
+        let model = subdyn::io::read_mesh(d.join("model.obj")).unwrap();
+        let ffd = Ffd::new(
+            &lat,
+            &model.positions,
+            &FfdParams {
+                levels: 2,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let mut moved = lat.positions.clone();
+        moved[top].z += 0.5;
+        let want = ffd.deform(&moved).unwrap();
+        let got = obj_vertices(&d.join("out.obj"));
+        assert_eq!(got.len(), 9);
+        for (a, b) in got.iter().zip(&want) {
+            assert!((a - b).norm() < 1e-9, "{a:?} vs {b:?}");
+        }
+        assert!(
+            got[6].z > 0.8 + 1e-3,
+            "the corner near the moved control point rose"
+        );
+        assert_eq!(got[8], Point3::new(3.0, 3.0, 3.0));
+        // The same deformation given as a whole deformed lattice.
+        let mut lat2 = lat.clone();
+        lat2.positions = moved;
+        write_lattice(d.join("lat2.json"), &lat2).unwrap();
+        let out = subdyn(
+            d,
+            &[
+                "ffd",
+                "model.obj",
+                "--lattice",
+                "lat.json",
+                "--deformed",
+                "lat2.json",
+                "--levels",
+                "2",
+                "-o",
+                "out2.obj",
+                "--quiet",
+            ],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        let got2 = obj_vertices(&d.join("out2.obj"));
+        for (a, b) in got2.iter().zip(&got) {
+            assert!((a - b).norm() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn ffd_bad_inputs_fail_with_one_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::write(d.join("model.obj"), MODEL).unwrap();
+        let lat = box_grid(Point3::origin(), Point3::new(1.0, 1.0, 1.0), [1, 1, 1]).unwrap();
+        write_lattice(d.join("lat.json"), &lat).unwrap();
+        let big = box_grid(Point3::origin(), Point3::new(1.0, 1.0, 1.0), [2, 1, 1]).unwrap();
+        write_lattice(d.join("big.json"), &big).unwrap();
+        std::fs::write(
+            d.join("broken.json"),
+            "{\"vertices\": [[0, 0, 0],\n [1, 0 0]]}",
+        )
+        .unwrap();
+        let flat = "{\"vertices\": [[0,0,0],[1,0,0],[1,1,0],[0,1,0],[0,0,0],[1,0,0],[1,1,0],[0,1,0.0000000000001]], \
+                    \"hexahedra\": [[0,1,2,3,4,5,6,7]]}";
+        std::fs::write(d.join("flat.json"), flat).unwrap();
+        std::fs::write(
+            d.join("far.json"),
+            "{\"moves\": [{\"vertex\": 99, \"offset\": [0, 0, 1]}]}",
+        )
+        .unwrap();
+        std::fs::write(
+            d.join("nan.json"),
+            "{\"moves\": [{\"vertex\": 1, \"offset\": [NaN, 0, 1]}]}",
+        )
+        .unwrap();
+        std::fs::write(d.join("both.json"), "{\"moves\": [{\"vertex\": 1}]}").unwrap();
+        let run = |lattice: &str, extra: &[&str]| {
+            let mut args = vec!["ffd", "model.obj", "--lattice", lattice, "-o", "out.obj"];
+            args.extend_from_slice(extra);
+            if !extra.contains(&"--levels") {
+                args.extend_from_slice(&["--levels", "1"]);
+            }
+            subdyn(d, &args)
+        };
+        assert_clean_failure(
+            d,
+            &run("broken.json", &["--deformed", "lat.json"]),
+            "broken.json:2",
+        );
+        assert_clean_failure(
+            d,
+            &run("flat.json", &["--deformed", "lat.json"]),
+            "degenerate",
+        );
+        assert_clean_failure(
+            d,
+            &run("lat.json", &["--deformed", "big.json"]),
+            "not the same lattice",
+        );
+        assert_clean_failure(
+            d,
+            &run("lat.json", &["--moves", "far.json"]),
+            "vertex 99 does not exist",
+        );
+        assert_clean_failure(d, &run("lat.json", &["--moves", "nan.json"]), "nan.json:1");
+        assert_clean_failure(
+            d,
+            &run("lat.json", &["--moves", "both.json"]),
+            "exactly one",
+        );
+        assert_clean_failure(
+            d,
+            &run("lat.json", &["--moves", "far.json", "--levels", "9"]),
+            "--levels 9",
+        );
+    }
+}

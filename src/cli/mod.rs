@@ -6,6 +6,7 @@ mod bench_closest;
 mod bench_distance;
 mod common;
 mod compare;
+mod ffd;
 mod fit;
 mod info;
 mod limit;
