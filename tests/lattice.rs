@@ -331,3 +331,121 @@ fn lattice_json_round_trips_and_reports_bad_files() {
     let e = bad(&hex.replace("\"hexahedra\"", "\"hexahedron\""));
     assert!(e.contains("unknown field"), "{e}");
 }
+
+#[test]
+fn box_lattices_enclose_the_model_and_cull_empty_cells() {
+    use subdyn::lattice::{BoxKind, BoxLatticeParams, box_lattice};
+    // Points on a thin rotated slab.
+    let mut rng = Rng::new(21);
+    let rot = nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.4, -0.7, 0.2));
+    let pts: Vec<Point3> = (0..500)
+        .map(|_| {
+            rot * p(
+                rng.uniform(-2.0, 2.0),
+                rng.uniform(-1.0, 1.0),
+                rng.uniform(-0.1, 0.1),
+            )
+        })
+        .collect();
+    let volume = |kind, levels, cull| {
+        let params = BoxLatticeParams {
+            kind,
+            octree_levels: levels,
+            cull,
+            ..Default::default()
+        };
+        let lat = box_lattice(&pts, &params).unwrap();
+        let v: f64 = lat.cell_volumes().unwrap().iter().sum();
+        (lat, v)
+    };
+    let (aabb, v_aabb) = volume(BoxKind::Aabb, 0, true);
+    let (obb, v_obb) = volume(BoxKind::Obb, 0, true);
+    assert_eq!(aabb.topology.num_cells(), 1);
+    assert!(
+        v_obb < 0.5 * v_aabb,
+        "OBB {v_obb} not tighter than AABB {v_aabb}"
+    );
+    // The OBB is the slab grown by 5 % of the diagonal: ≈ (4 + 2m)(2 + 2m)(0.2 + 2m).
+    let m = 0.05 * common::diag(&pts);
+    let expect = (4.0 + 2.0 * m) * (2.0 + 2.0 * m) * (0.2 + 2.0 * m);
+    assert!(
+        (v_obb - expect).abs() < 0.1 * expect,
+        "OBB volume {v_obb}, expected ≈ {expect}"
+    );
+    let ffd = subdyn::ffd::Ffd::new(
+        &obb,
+        &pts,
+        &subdyn::ffd::FfdParams {
+            levels: 1,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(ffd.report.outside, 0, "OBB lattice misses vertices");
+    let (full, _) = volume(BoxKind::Obb, 3, false);
+    let (culled, _) = volume(BoxKind::Obb, 3, true);
+    assert_eq!(full.topology.num_cells(), 512);
+    assert!(culled.topology.num_cells() < 512 && culled.topology.num_cells() >= 64);
+    assert!(
+        box_lattice(
+            &pts,
+            &BoxLatticeParams {
+                octree_levels: 9,
+                ..Default::default()
+            }
+        )
+        .is_err()
+    );
+    assert!(box_lattice(&[], &BoxLatticeParams::default()).is_err());
+}
+
+#[test]
+fn lattice_cli_writes_a_readable_lattice_and_refuses_bad_input() {
+    use std::process::Command;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cube = subdyn::examples::cube();
+    subdyn::io::write_mesh(d.join("m.obj"), &cube, None).unwrap();
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_subdyn"))
+            .args(args)
+            .current_dir(d)
+            .output()
+            .unwrap()
+    };
+    let out = run(&[
+        "lattice",
+        "m.obj",
+        "-o",
+        "lat.json",
+        "--box",
+        "obb",
+        "--octree-levels",
+        "2",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lat = subdyn::io::read_lattice(d.join("lat.json")).unwrap();
+    assert!(lat.topology.num_cells() > 8 && lat.topology.num_cells() <= 64);
+    for (args, needle) in [
+        (vec!["lattice", "m.obj", "-o", "lat.obj"], "json"),
+        (
+            vec!["lattice", "m.obj", "-o", "x.json", "--octree-levels", "12"],
+            "octree levels",
+        ),
+        (
+            vec!["lattice", "missing.obj", "-o", "x.json"],
+            "missing.obj",
+        ),
+    ] {
+        let out = run(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(needle), "`{needle}` not in {err}");
+        assert!(!d.join("x.json").exists());
+    }
+}

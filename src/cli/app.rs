@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use super::{bench, common, compare, ffd, fit, info, limit, render, subdivide};
+use super::{bench, common, compare, ffd, fit, info, lattice, limit, render, subdivide};
 
 /// subdyn: Catmull-Clark subdivision surfaces — refinement as stencil tables,
 /// exact limit evaluation, mesh inspection and benchmarks.
@@ -36,6 +36,8 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Draw a mesh and/or point cloud to a PNG (software rasteriser).
     Render(render::RenderArgs),
+    /// Build a lattice around a model: bounding box (AABB or PCA-oriented), octree levels, empty cells culled.
+    Lattice(lattice::LatticeArgs),
     /// Free-form deformation of a mesh with a Catmull-Clark volume lattice of any topology.
     Ffd(ffd::FfdArgs),
     /// Benchmarks (timings as a table, then one JSON line).
@@ -56,6 +58,7 @@ pub fn run() -> ExitCode {
         Command::Compare(args) => compare::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Ffd(args) => ffd::run(&args),
+        Command::Lattice(args) => lattice::run(&args),
         Command::Bench(cmd) => bench::run(&cmd),
     };
     match result {

@@ -9,6 +9,7 @@ mod compare;
 mod ffd;
 mod fit;
 mod info;
+mod lattice;
 mod limit;
 mod mesh_stats;
 mod options;

@@ -18,6 +18,7 @@
 //! assert_eq!(p2.len(), 125); // a 4×4×4-cell grid, still exactly the cube
 //! ```
 
+mod box_lattice;
 mod builders;
 mod hierarchy;
 #[allow(clippy::module_inception)]
@@ -26,6 +27,7 @@ mod refine_topology;
 mod rules;
 mod topology;
 
+pub use box_lattice::{BoxKind, BoxLatticeParams, bounding_frame, box_lattice};
 pub use builders::{HEX_FACES, LatticeBuilder, box_grid, cylinder, extrude, hexahedra};
 pub use hierarchy::{LatticeHierarchy, LatticeLevel, MAX_LATTICE_LEVELS};
 pub use lattice::{BoundaryTags, Lattice, cell_volume, check_geometry};
