@@ -111,6 +111,18 @@ impl Lattice {
         self.positions.len()
     }
 
+    /// The boundary faces (those of one cell) as a polygon mesh over all the
+    /// lattice's positions: the lattice's hull, e.g. to draw it.
+    pub fn boundary_mesh(&self) -> Result<crate::mesh::PolyMesh> {
+        let t = &self.topology;
+        let faces: Vec<Vec<u32>> = t
+            .boundary_faces()
+            .iter()
+            .map(|&f| t.faces.row(f as usize).to_vec())
+            .collect();
+        crate::mesh::PolyMesh::from_faces(self.positions.clone(), &faces)
+    }
+
     /// Volume of every cell (faces fanned from their centroids, divergence
     /// theorem over the consistently oriented cell surface).
     pub fn cell_volumes(&self) -> Result<Vec<Real>> {
