@@ -28,10 +28,12 @@
 pub mod dynamics;
 pub mod error;
 pub mod examples;
+pub mod ffd;
 pub mod finetune;
 pub mod fit;
 pub mod forces;
 pub mod io;
+pub mod lattice;
 pub mod limit;
 pub mod math;
 pub mod mesh;

@@ -7,7 +7,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use super::{bench, common, compare, finetune, fit, info, limit, recover, render, subdivide};
+use super::{
+    bench, common, compare, ffd, finetune, fit, info, lattice, limit, recover, render, subdivide,
+};
 
 /// subdyn: Catmull-Clark subdivision surfaces — refinement as stencil tables,
 /// exact limit evaluation, mesh inspection and benchmarks.
@@ -41,6 +43,10 @@ enum Command {
     /// Fine tuning by scaling derivatives: a new shape whose derivatives are the old ones scaled by α.
     #[command(subcommand)]
     Finetune(finetune::FinetuneCommand),
+    /// Build a lattice around a model: bounding box (AABB or PCA-oriented), octree levels, empty cells culled.
+    Lattice(lattice::LatticeArgs),
+    /// Free-form deformation of a mesh with a Catmull-Clark volume lattice of any topology.
+    Ffd(ffd::FfdArgs),
     /// Benchmarks (timings as a table, then one JSON line).
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -60,6 +66,8 @@ pub fn run() -> ExitCode {
         Command::Compare(args) => compare::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Finetune(cmd) => finetune::run(&cmd),
+        Command::Ffd(args) => ffd::run(&args),
+        Command::Lattice(args) => lattice::run(&args),
         Command::Bench(cmd) => bench::run(&cmd),
     };
     match result {

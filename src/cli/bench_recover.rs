@@ -76,7 +76,9 @@ pub fn bench_recover(args: &BenchRecoverArgs) -> anyhow::Result<()> {
     let mut gauss = move || {
         // Box-Muller on a 64-bit LCG: reproducible, dependency-free.
         let mut uniform = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((state >> 11) as Real + 0.5) / (1u64 << 53) as Real
         };
         let (u, v) = (uniform(), uniform());

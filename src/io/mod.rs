@@ -16,6 +16,7 @@
 mod atomic;
 mod creases;
 mod format;
+mod lattice;
 mod obj;
 mod off;
 mod ply;
@@ -30,6 +31,9 @@ mod xyz;
 pub use atomic::atomic_write;
 pub use creases::read_creases;
 pub use format::MeshFormat;
+pub use lattice::{
+    LATTICE_FORMAT, lattice_from_json, lattice_to_json, read_lattice, write_lattice,
+};
 pub use read::{
     read_mesh, read_mesh_from_bytes, read_obj_from_bytes, read_points, read_points_from_bytes,
 };

@@ -495,3 +495,5 @@ pub fn run_subdyn(dir: &Path, args: &[&str]) -> std::process::Output {
         .output()
         .expect("the subdyn binary runs")
 }
+
+pub mod volume;

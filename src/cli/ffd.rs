@@ -1,0 +1,188 @@
+//! `subdyn ffd MODEL --lattice LAT.json (--deformed LAT2.json | --moves MOVES.json)
+//! [--levels N] -o OUT.obj [--report R.json]`: free-form deformation of a
+//! mesh with a Catmull-Clark volume lattice (MacCracken & Joy 1996).
+//!
+//! MOVES.json lists control-point moves:
+//! `{"moves": [{"vertex": 3, "offset": [0, 0, 0.5]}, {"vertex": 7, "position": [1, 2, 3]}]}`.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use serde::Deserialize;
+use serde_json::json;
+
+use subdyn::ffd::{Ffd, FfdParams};
+use subdyn::io::{read_lattice, write_mesh};
+use subdyn::lattice::MAX_LATTICE_LEVELS;
+use subdyn::math::{Point3, Vector3};
+
+use super::common::{
+    about_file, check_mesh_output, print_stdout, seconds, thousands, write_report,
+};
+use super::options::read_polygon_mesh;
+use super::progress::Progress;
+
+/// Arguments of `subdyn ffd`.
+#[derive(Debug, Args)]
+pub struct FfdArgs {
+    /// The model to deform (.obj, .ply, .off).
+    #[arg(value_name = "MODEL")]
+    pub model: PathBuf,
+    /// The lattice in its rest position (lattice JSON).
+    #[arg(long, value_name = "LAT.json")]
+    pub lattice: PathBuf,
+    /// The same lattice with moved control points.
+    #[arg(
+        long,
+        value_name = "LAT2.json",
+        conflicts_with = "moves",
+        required_unless_present = "moves"
+    )]
+    pub deformed: Option<PathBuf>,
+    /// Control-point moves (JSON, see `subdyn ffd --help`).
+    #[arg(long, value_name = "MOVES.json")]
+    pub moves: Option<PathBuf>,
+    /// Refinement levels of the lattice (1 to 6).
+    #[arg(long, value_name = "N", default_value_t = 3)]
+    pub levels: usize,
+    /// Output mesh; the format follows the extension.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Write a JSON report (embedded / outside counts, timings).
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<PathBuf>,
+    /// No progress display and no warnings.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MovesFile {
+    moves: Vec<Move>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Move {
+    vertex: usize,
+    #[serde(default)]
+    offset: Option<[f64; 3]>,
+    #[serde(default)]
+    position: Option<[f64; 3]>,
+}
+
+/// The moved control points from a moves file.
+fn read_moves(path: &Path, rest: &[Point3]) -> anyhow::Result<Vec<Point3>> {
+    let bytes = std::fs::read(path).map_err(|e| subdyn::Error::io(path, e))?;
+    let file: MovesFile = serde_json::from_slice(&bytes)
+        .map_err(|e| subdyn::Error::parse(path, e.line(), e.to_string()))?;
+    let mut out = rest.to_vec();
+    for (i, m) in file.moves.iter().enumerate() {
+        let name = path.display();
+        let q = out.get_mut(m.vertex).ok_or_else(|| {
+            anyhow::anyhow!(
+                "{name}: move {i}: vertex {} does not exist (the lattice has {} control points)",
+                m.vertex,
+                rest.len()
+            )
+        })?;
+        match (m.offset, m.position) {
+            (Some(d), None) => *q += Vector3::new(d[0], d[1], d[2]),
+            (None, Some(p)) => *q = Point3::new(p[0], p[1], p[2]),
+            _ => anyhow::bail!("{name}: move {i}: give exactly one of \"offset\" and \"position\""),
+        }
+    }
+    Ok(out)
+}
+
+/// Runs `subdyn ffd`.
+pub fn run(args: &FfdArgs) -> anyhow::Result<()> {
+    let start = Instant::now();
+    check_mesh_output(&args.output)?;
+    if args.levels == 0 || args.levels > MAX_LATTICE_LEVELS {
+        anyhow::bail!(
+            "--levels {} is out of range: expected 1 to {MAX_LATTICE_LEVELS}",
+            args.levels
+        );
+    }
+    let progress = Progress::new(args.quiet);
+    progress.stage("reading the model and the lattice");
+    let mesh = read_polygon_mesh(&args.model, args.quiet)?;
+    let lattice = read_lattice(&args.lattice).map_err(|e| about_file(e, &args.lattice))?;
+    let moved = match (&args.deformed, &args.moves) {
+        (Some(path), _) => {
+            let d = read_lattice(path).map_err(|e| about_file(e, path))?;
+            if d.topology != lattice.topology {
+                anyhow::bail!(
+                    "{}: not the same lattice as {} ({} vertices, {} cells against {} and {})",
+                    path.display(),
+                    args.lattice.display(),
+                    d.num_vertices(),
+                    d.topology.num_cells(),
+                    lattice.num_vertices(),
+                    lattice.topology.num_cells()
+                );
+            }
+            d.positions
+        }
+        (None, Some(path)) => read_moves(path, &lattice.positions)?,
+        (None, None) => anyhow::bail!("give --deformed or --moves"),
+    };
+    progress.stage(format!(
+        "refining the lattice {} times and embedding",
+        args.levels
+    ));
+    let params = FfdParams {
+        levels: args.levels,
+        ..Default::default()
+    };
+    let ffd = Ffd::new(&lattice, &mesh.positions, &params)?;
+    let t = Instant::now();
+    let positions = ffd
+        .deform(&moved)
+        .map_err(|e| about_file(e, &args.output))?;
+    let deform_s = seconds(t);
+    let mut out = mesh.clone();
+    out.positions = positions;
+    progress.stage(format!("writing {}", args.output.display()));
+    write_mesh(&args.output, &out, None).map_err(|e| about_file(e, &args.output))?;
+    drop(progress);
+    let r = &ffd.report;
+    if r.outside > 0 && !args.quiet {
+        super::common::warn(
+            args.quiet,
+            &format!(
+                "{} of {} vertices lie outside the lattice and were not moved",
+                thousands(r.outside),
+                thousands(r.points)
+            ),
+        );
+    }
+    if let Some(report) = &args.report {
+        let value = json!({
+            "command": "ffd",
+            "model": args.model.display().to_string(),
+            "lattice": args.lattice.display().to_string(),
+            "output": args.output.display().to_string(),
+            "ffd": r,
+            "lattice_vertices": lattice.num_vertices(),
+            "lattice_cells": lattice.topology.num_cells(),
+            "timings_s": {"refine": r.refine_s, "embed": r.embed_s, "deform": deform_s, "total": seconds(start)},
+        });
+        write_report(report, &value)?;
+    }
+    print_stdout(&format!(
+        "deformed {} of {} vertices of {} with {} ({} cells, {} levels → {} cells); {} outside; written to {}\n",
+        thousands(r.embedded),
+        thousands(r.points),
+        args.model.display(),
+        args.lattice.display(),
+        lattice.topology.num_cells(),
+        args.levels,
+        thousands(r.level_cells),
+        thousands(r.outside),
+        args.output.display()
+    ))
+}

@@ -1,0 +1,94 @@
+//! `subdyn lattice MODEL -o LAT.json [--box aabb|obb] [--octree-levels K]
+//! [--margin F] [--no-cull]`: an automatic lattice around a model
+//! (multiresolution-lattice FFD paper: bounding box, octree levels, culling).
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+use serde_json::json;
+
+use subdyn::io::{read_mesh, write_lattice};
+use subdyn::lattice::{BoxKind, BoxLatticeParams, box_lattice};
+
+use super::common::{about_file, print_stdout, thousands, write_report};
+
+/// Box orientation on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum BoxArg {
+    /// Axis-aligned bounding box.
+    Aabb,
+    /// Oriented bounding box along the principal axes (PCA).
+    Obb,
+}
+
+/// Arguments of `subdyn lattice`.
+#[derive(Debug, Args)]
+pub struct LatticeArgs {
+    /// The model (.obj, .ply, .off, .xyz): its vertices decide the box and the culling.
+    #[arg(value_name = "MODEL")]
+    pub model: PathBuf,
+    /// Output lattice JSON.
+    #[arg(short, long, value_name = "LAT.json")]
+    pub output: PathBuf,
+    /// Box orientation.
+    #[arg(long = "box", value_enum, default_value_t = BoxArg::Aabb)]
+    pub kind: BoxArg,
+    /// Octree levels K: 2^K cells per axis before culling (0 to 7).
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    pub octree_levels: usize,
+    /// Margin on every side, as a fraction of the model's diagonal.
+    #[arg(long, value_name = "F", default_value_t = 0.05)]
+    pub margin: f64,
+    /// Keep the cells that hold no model vertex.
+    #[arg(long)]
+    pub no_cull: bool,
+    /// Write a JSON report.
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<PathBuf>,
+}
+
+/// Runs `subdyn lattice`.
+pub fn run(args: &LatticeArgs) -> anyhow::Result<()> {
+    if args.output.extension().and_then(|e| e.to_str()) != Some("json") {
+        anyhow::bail!(
+            "{}: the lattice is written as JSON; use a .json name",
+            args.output.display()
+        );
+    }
+    let mesh = read_mesh(&args.model).map_err(|e| about_file(e, &args.model))?;
+    let params = BoxLatticeParams {
+        kind: match args.kind {
+            BoxArg::Aabb => BoxKind::Aabb,
+            BoxArg::Obb => BoxKind::Obb,
+        },
+        margin: args.margin,
+        octree_levels: args.octree_levels,
+        cull: !args.no_cull,
+        ..Default::default()
+    };
+    let lat = box_lattice(&mesh.positions, &params).map_err(|e| about_file(e, &args.model))?;
+    write_lattice(&args.output, &lat).map_err(|e| about_file(e, &args.output))?;
+    if let Some(report) = &args.report {
+        write_report(
+            report,
+            &json!({
+                "command": "lattice",
+                "model": args.model.display().to_string(),
+                "output": args.output.display().to_string(),
+                "vertices": lat.num_vertices(),
+                "cells": lat.topology.num_cells(),
+                "octree_levels": args.octree_levels,
+                "cells_before_culling": 1usize << (3 * args.octree_levels),
+            }),
+        )?;
+    }
+    print_stdout(&format!(
+        "lattice around {} ({} vertices): {} control points, {} cells (of {} before culling), written to {}\n",
+        args.model.display(),
+        thousands(mesh.num_vertices()),
+        thousands(lat.num_vertices()),
+        thousands(lat.topology.num_cells()),
+        thousands(1usize << (3 * args.octree_levels)),
+        args.output.display()
+    ))
+}

@@ -1,0 +1,425 @@
+//! `LatticeTopology`: vertices, edges, faces and cells of a volume lattice of
+//! arbitrary topology (no positions), with the adjacency the Catmull-Clark
+//! volume rules need (MacCracken & Joy 1996, §2.2).
+//!
+//! Faces are vertex loops; cells are lists of faces. Edges and every
+//! incidence relation are derived once when the topology is built, and the
+//! topological checks (closed cells, at most two cells per face, no repeated
+//! faces, connectedness) run there, each naming the failing element.
+
+use std::collections::HashMap;
+
+use crate::error::{Error, Result};
+
+/// Marker for "no cell" in [`LatticeTopology::face_cells`].
+pub const NO_CELL: u32 = u32::MAX;
+
+/// A compressed-row list of lists of `u32`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Csr {
+    /// `len + 1` offsets into `items`.
+    pub offsets: Vec<u32>,
+    /// The concatenated lists.
+    pub items: Vec<u32>,
+}
+
+impl Csr {
+    /// Builds from a list of lists.
+    pub fn from_lists<L: AsRef<[u32]>>(lists: &[L]) -> Csr {
+        let mut c = Csr {
+            offsets: Vec::with_capacity(lists.len() + 1),
+            items: Vec::new(),
+        };
+        c.offsets.push(0);
+        for l in lists {
+            c.items.extend_from_slice(l.as_ref());
+            c.offsets.push(c.items.len() as u32);
+        }
+        c
+    }
+
+    /// Groups `(row, item)` pairs into `rows` lists (items in pair order).
+    pub fn from_pairs(rows: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) -> Csr {
+        let mut offsets = vec![0u32; rows + 1];
+        for (r, _) in pairs.clone() {
+            offsets[r as usize + 1] += 1;
+        }
+        for i in 0..rows {
+            offsets[i + 1] += offsets[i];
+        }
+        let mut next = offsets.clone();
+        let mut items = vec![0u32; offsets[rows] as usize];
+        for (r, x) in pairs {
+            items[next[r as usize] as usize] = x;
+            next[r as usize] += 1;
+        }
+        Csr { offsets, items }
+    }
+
+    /// Number of lists.
+    pub fn len(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    /// True when there is no list.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// List `i`.
+    pub fn row(&self, i: usize) -> &[u32] {
+        &self.items[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    }
+
+    /// Bytes held by the two arrays.
+    pub fn bytes(&self) -> usize {
+        4 * (self.offsets.len() + self.items.len())
+    }
+}
+
+/// The topology of a volume lattice: faces as vertex loops, cells as face
+/// lists, and the derived edges and incidences.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LatticeTopology {
+    /// Number of vertices.
+    pub num_vertices: usize,
+    /// Vertex loop of every face.
+    pub faces: Csr,
+    /// Faces of every cell.
+    pub cells: Csr,
+    /// Edges as `[a, b]` with `a < b`.
+    pub edges: Vec<[u32; 2]>,
+    /// Edge `i` of a face joins its vertices `i` and `i + 1` (same layout as `faces`).
+    pub face_edges: Csr,
+    /// The one or two cells of every face ([`NO_CELL`] in the second slot for a boundary face).
+    pub face_cells: Vec<[u32; 2]>,
+    /// Faces around every edge.
+    pub edge_faces: Csr,
+    /// Cells around every edge.
+    pub edge_cells: Csr,
+    /// Distinct vertices of every cell.
+    pub cell_vertices: Csr,
+    /// Cells around every vertex.
+    pub vertex_cells: Csr,
+    /// Faces around every vertex.
+    pub vertex_faces: Csr,
+    /// Edges at every vertex.
+    pub vertex_edges: Csr,
+}
+
+fn edge_key(a: u32, b: u32) -> u64 {
+    let (a, b) = if a < b { (a, b) } else { (b, a) };
+    ((a as u64) << 32) | b as u64
+}
+
+impl LatticeTopology {
+    /// Builds and checks a topology from face loops and cells (lists of face
+    /// indices). Errors name the face or cell: index out of range, a face
+    /// with fewer than three distinct vertices, a repeated face, a face in no
+    /// cell or in more than two, a cell that is not closed (an edge of it not
+    /// in exactly two of its faces), a cell whose surface is not a sphere,
+    /// cells not connected through faces, a vertex in no face.
+    pub fn new<F: AsRef<[u32]>, C: AsRef<[u32]>>(
+        num_vertices: usize,
+        faces: &[F],
+        cells: &[C],
+    ) -> Result<LatticeTopology> {
+        if cells.is_empty() {
+            return Err(Error::Topology("the lattice has no cell".into()));
+        }
+        let mut seen_faces: HashMap<Vec<u32>, usize> = HashMap::new();
+        for (f, loop_) in faces.iter().enumerate() {
+            let l = loop_.as_ref();
+            if let Some(&v) = l.iter().find(|&&v| v as usize >= num_vertices) {
+                return Err(Error::Topology(format!(
+                    "face {f}: vertex {v} out of range (the lattice has {num_vertices} vertices)"
+                )));
+            }
+            let mut key = l.to_vec();
+            key.sort_unstable();
+            key.dedup();
+            if key.len() < 3 || key.len() != l.len() {
+                return Err(Error::Topology(format!(
+                    "face {f}: needs at least three distinct vertices, got {l:?}"
+                )));
+            }
+            if let Some(g) = seen_faces.insert(key, f) {
+                return Err(Error::Topology(format!(
+                    "face {f} repeats face {g} (same vertices)"
+                )));
+            }
+        }
+        let faces = Csr::from_lists(faces);
+        let cells = Csr::from_lists(cells);
+        let nf = faces.len();
+        let mut face_cells = vec![[NO_CELL; 2]; nf];
+        for c in 0..cells.len() {
+            let fs = cells.row(c);
+            if fs.len() < 4 {
+                return Err(Error::Topology(format!(
+                    "cell {c}: has {} faces, a closed cell needs at least 4",
+                    fs.len()
+                )));
+            }
+            for &f in fs {
+                let slot = face_cells.get_mut(f as usize).ok_or_else(|| {
+                    Error::Topology(format!("cell {c}: face {f} out of range ({nf} faces)"))
+                })?;
+                if slot[0] == c as u32 || slot[1] == c as u32 {
+                    return Err(Error::Topology(format!("cell {c}: lists face {f} twice")));
+                }
+                if slot[0] == NO_CELL {
+                    slot[0] = c as u32;
+                } else if slot[1] == NO_CELL {
+                    slot[1] = c as u32;
+                } else {
+                    return Err(Error::Topology(format!(
+                        "face {f}: belongs to more than two cells ({}, {}, {c})",
+                        slot[0], slot[1]
+                    )));
+                }
+            }
+        }
+        if let Some(f) = face_cells.iter().position(|s| s[0] == NO_CELL) {
+            return Err(Error::Topology(format!("face {f}: belongs to no cell")));
+        }
+        // Edges.
+        let mut edge_ids: HashMap<u64, u32> = HashMap::new();
+        let mut edges = Vec::new();
+        let mut fe = Vec::with_capacity(faces.items.len());
+        for f in 0..nf {
+            let l = faces.row(f);
+            for i in 0..l.len() {
+                let (a, b) = (l[i], l[(i + 1) % l.len()]);
+                let id = *edge_ids.entry(edge_key(a, b)).or_insert_with(|| {
+                    edges.push([a.min(b), a.max(b)]);
+                    (edges.len() - 1) as u32
+                });
+                fe.push(id);
+            }
+        }
+        let face_edges = Csr {
+            offsets: faces.offsets.clone(),
+            items: fe,
+        };
+        let ne = edges.len();
+        let edge_faces = Csr::from_pairs(
+            ne,
+            (0..nf).flat_map(|f| face_edges.row(f).iter().map(move |&e| (e, f as u32))),
+        );
+        // Cell closure: each edge of a cell in exactly two of its faces.
+        let mut cell_vertex_lists = Vec::with_capacity(cells.len());
+        let mut count: HashMap<u32, u32> = HashMap::new();
+        for c in 0..cells.len() {
+            count.clear();
+            let mut verts = Vec::new();
+            for &f in cells.row(c) {
+                for &e in face_edges.row(f as usize) {
+                    *count.entry(e).or_insert(0) += 1;
+                }
+                verts.extend_from_slice(faces.row(f as usize));
+            }
+            if let Some((&e, &k)) = count.iter().find(|(_, k)| **k != 2) {
+                let [a, b] = edges[e as usize];
+                return Err(Error::Topology(format!(
+                    "cell {c}: not closed — edge {a}-{b} is in {k} of its faces (expected 2)"
+                )));
+            }
+            verts.sort_unstable();
+            verts.dedup();
+            let euler = verts.len() as i64 - count.len() as i64 + cells.row(c).len() as i64;
+            if euler != 2 {
+                return Err(Error::Topology(format!(
+                    "cell {c}: its faces do not bound a ball (V - E + F = {euler}, expected 2)"
+                )));
+            }
+            cell_vertex_lists.push(verts);
+        }
+        let cell_vertices = Csr::from_lists(&cell_vertex_lists);
+        let edge_cells = {
+            let mut lists: Vec<Vec<u32>> = vec![Vec::new(); ne];
+            for (e, list) in lists.iter_mut().enumerate() {
+                for &f in edge_faces.row(e) {
+                    for &c in &face_cells[f as usize] {
+                        if c != NO_CELL && !list.contains(&c) {
+                            list.push(c);
+                        }
+                    }
+                }
+            }
+            Csr::from_lists(&lists)
+        };
+        let nc = cells.len();
+        let vertex_cells = Csr::from_pairs(
+            num_vertices,
+            (0..nc).flat_map(|c| cell_vertices.row(c).iter().map(move |&v| (v, c as u32))),
+        );
+        let vertex_faces = Csr::from_pairs(
+            num_vertices,
+            (0..nf).flat_map(|f| faces.row(f).iter().map(move |&v| (v, f as u32))),
+        );
+        let vertex_edges = Csr::from_pairs(
+            num_vertices,
+            edges
+                .iter()
+                .enumerate()
+                .flat_map(|(e, &[a, b])| [(a, e as u32), (b, e as u32)]),
+        );
+        if let Some(v) = (0..num_vertices).find(|&v| vertex_faces.row(v).is_empty()) {
+            return Err(Error::Topology(format!("vertex {v}: belongs to no face")));
+        }
+        let topo = LatticeTopology {
+            num_vertices,
+            faces,
+            cells,
+            edges,
+            face_edges,
+            face_cells,
+            edge_faces,
+            edge_cells,
+            cell_vertices,
+            vertex_cells,
+            vertex_faces,
+            vertex_edges,
+        };
+        topo.check_connected()?;
+        Ok(topo)
+    }
+
+    /// Builds a topology from cells given as polyhedra (each a list of vertex
+    /// loops); faces shared by two cells are found by their vertex sets.
+    pub fn from_polyhedra(num_vertices: usize, cells: &[Vec<Vec<u32>>]) -> Result<LatticeTopology> {
+        let mut ids: HashMap<Vec<u32>, u32> = HashMap::new();
+        let mut faces: Vec<Vec<u32>> = Vec::new();
+        let mut cell_faces = Vec::with_capacity(cells.len());
+        for cell in cells {
+            let mut list = Vec::with_capacity(cell.len());
+            for l in cell {
+                let mut key = l.clone();
+                key.sort_unstable();
+                let id = *ids.entry(key).or_insert_with(|| {
+                    faces.push(l.clone());
+                    (faces.len() - 1) as u32
+                });
+                list.push(id);
+            }
+            cell_faces.push(list);
+        }
+        LatticeTopology::new(num_vertices, &faces, &cell_faces)
+    }
+
+    fn check_connected(&self) -> Result<()> {
+        let nc = self.cells.len();
+        let mut seen = vec![false; nc];
+        let mut stack = vec![0usize];
+        seen[0] = true;
+        while let Some(c) = stack.pop() {
+            for &f in self.cells.row(c) {
+                for &d in &self.face_cells[f as usize] {
+                    if d != NO_CELL && !seen[d as usize] {
+                        seen[d as usize] = true;
+                        stack.push(d as usize);
+                    }
+                }
+            }
+        }
+        match seen.iter().position(|s| !s) {
+            Some(c) => Err(Error::Topology(format!(
+                "cell {c}: not connected to cell 0 through shared faces (the lattice must be connected)"
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// Number of cells.
+    pub fn num_cells(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// Number of faces.
+    pub fn num_faces(&self) -> usize {
+        self.faces.len()
+    }
+
+    /// Number of edges.
+    pub fn num_edges(&self) -> usize {
+        self.edges.len()
+    }
+
+    /// True for a face with a single cell.
+    pub fn is_boundary_face(&self, f: usize) -> bool {
+        self.face_cells[f][1] == NO_CELL
+    }
+
+    /// Indices of the boundary faces (one cell).
+    pub fn boundary_faces(&self) -> Vec<u32> {
+        (0..self.num_faces())
+            .filter(|&f| self.is_boundary_face(f))
+            .map(|f| f as u32)
+            .collect()
+    }
+
+    /// The faces of cell `c` around its vertex `v` in cyclic order, as the
+    /// ring `[e_1, f_1, e_2, f_2, …, e_n, f_n]` where face `f_i` holds edges
+    /// `e_i` and `e_{i+1}` (indices into edges and faces). `n` is the valence
+    /// of `v` in `c` (MacCracken & Joy 1996, §2.2).
+    pub fn corner_ring(&self, c: usize, v: u32) -> Result<Vec<u32>> {
+        let cell_faces = self.cells.row(c);
+        // (face, edge-in, edge-out) for the faces of c at v.
+        let mut at_v: Vec<(u32, u32, u32)> = Vec::new();
+        for &f in cell_faces {
+            let l = self.faces.row(f as usize);
+            if let Some(i) = l.iter().position(|&x| x == v) {
+                let es = self.face_edges.row(f as usize);
+                let prev = es[(i + l.len() - 1) % l.len()];
+                at_v.push((f, prev, es[i]));
+            }
+        }
+        let n = at_v.len();
+        let bad = || {
+            Error::Topology(format!(
+                "cell {c}: its faces at vertex {v} do not form one fan (the cell is pinched there)"
+            ))
+        };
+        if n < 3 {
+            return Err(bad());
+        }
+        let mut ring = Vec::with_capacity(2 * n);
+        let (f0, e_first, mut e) = at_v[0];
+        ring.push(e_first);
+        ring.push(f0);
+        let mut cur = f0;
+        for _ in 1..n {
+            let next = at_v
+                .iter()
+                .find(|&&(f, a, b)| f != cur && (a == e || b == e))
+                .ok_or_else(bad)?;
+            if ring.iter().skip(1).step_by(2).any(|&f| f == next.0) {
+                return Err(bad());
+            }
+            ring.push(e);
+            ring.push(next.0);
+            cur = next.0;
+            e = if next.1 == e { next.2 } else { next.1 };
+        }
+        if e != e_first {
+            return Err(bad());
+        }
+        Ok(ring)
+    }
+
+    /// Bytes held by the topology's arrays.
+    pub fn bytes(&self) -> usize {
+        self.faces.bytes()
+            + self.cells.bytes()
+            + 8 * self.edges.len()
+            + self.face_edges.bytes()
+            + 8 * self.face_cells.len()
+            + self.edge_faces.bytes()
+            + self.edge_cells.bytes()
+            + self.cell_vertices.bytes()
+            + self.vertex_cells.bytes()
+            + self.vertex_faces.bytes()
+            + self.vertex_edges.bytes()
+    }
+}

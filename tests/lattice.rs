@@ -1,0 +1,451 @@
+//! Volume lattices and Catmull-Clark volume refinement (MacCracken & Joy 1996):
+//! topology checks, JSON, stencil invariants, the cube, tricubic reproduction.
+
+mod common;
+
+use common::Rng;
+use common::volume::{cubic_bspline, tricubic};
+use subdyn::lattice::{
+    Lattice, LatticeBuilder, LatticeHierarchy, LatticeTopology, box_grid, cylinder, extrude,
+    hexahedra,
+};
+use subdyn::math::{Point3, Vector3};
+use subdyn::mesh::PolyMesh;
+
+fn p(x: f64, y: f64, z: f64) -> Point3 {
+    Point3::new(x, y, z)
+}
+
+fn unit_cube() -> Lattice {
+    box_grid(p(0.0, 0.0, 0.0), p(1.0, 1.0, 1.0), [1, 1, 1]).unwrap()
+}
+
+/// A square pyramid: its apex has valence 4 in its cell.
+fn pyramid() -> Lattice {
+    let pos = vec![
+        p(0.0, 0.0, 0.0),
+        p(1.0, 0.0, 0.0),
+        p(1.0, 1.0, 0.0),
+        p(0.0, 1.0, 0.0),
+        p(0.5, 0.5, 1.0),
+    ];
+    let cell = vec![
+        vec![0, 3, 2, 1],
+        vec![0, 1, 4],
+        vec![1, 2, 4],
+        vec![2, 3, 4],
+        vec![3, 0, 4],
+    ];
+    let topo = LatticeTopology::from_polyhedra(5, &[cell]).unwrap();
+    Lattice::new(pos, topo).unwrap()
+}
+
+fn test_lattices() -> Vec<(&'static str, Lattice)> {
+    let mut rng = Rng::new(7);
+    let mut grid = box_grid(p(0.0, 0.0, 0.0), p(2.0, 1.0, 1.5), [3, 2, 2]).unwrap();
+    for q in &mut grid.positions {
+        q.coords += 0.05 * rng.vector();
+    }
+    vec![
+        ("cube", unit_cube()),
+        ("grid", grid),
+        ("cylinder", cylinder(1.0, 2.0, 6, 2).unwrap()),
+        ("pyramid", pyramid()),
+    ]
+}
+
+#[test]
+fn refinement_rows_sum_to_one_and_are_affine_invariant() {
+    let mut rng = Rng::new(3);
+    for (name, lat) in test_lattices() {
+        let h = LatticeHierarchy::new(&lat, 2).unwrap();
+        for (k, s) in h.stencils.iter().enumerate() {
+            for (r, sum) in s.row_sums().iter().enumerate() {
+                assert!(
+                    (sum - 1.0).abs() < 1e-12,
+                    "{name} level {k} row {r}: sum {sum}"
+                );
+            }
+            assert_eq!(s.num_rows(), h.level(k + 1).topology.num_vertices);
+        }
+        let s2 = h.stencil_to_level(2).unwrap();
+        let (a, b) = common::random_affine(&mut rng);
+        let moved = common::affine(&lat.positions, &a, &b);
+        let lhs = s2.apply(&moved).unwrap();
+        let rhs = common::affine(&s2.apply(&lat.positions).unwrap(), &a, &b);
+        let err = common::max_pairwise(&lhs, &rhs);
+        assert!(
+            err < 1e-12 * common::diag(&rhs),
+            "{name}: affine error {err}"
+        );
+    }
+}
+
+#[test]
+fn a_cube_lattice_refines_to_exactly_the_cube() {
+    let lat = unit_cube();
+    let h = LatticeHierarchy::new(&lat, 3).unwrap();
+    let levels = h.refine_positions(&lat.positions).unwrap();
+    for (k, pos) in levels.iter().enumerate().skip(1) {
+        let topo = &h.level(k).topology;
+        assert_eq!(topo.num_cells(), 8usize.pow(k as u32));
+        // Every boundary vertex on the cube's surface, every vertex inside it.
+        for f in topo.boundary_faces() {
+            for &v in topo.faces.row(f as usize) {
+                let q = pos[v as usize];
+                let on = (0..3).any(|i| q[i].abs() < 1e-14 || (q[i] - 1.0).abs() < 1e-14);
+                assert!(on, "level {k}: boundary vertex {v} at {q:?} off the cube");
+            }
+        }
+        assert!(
+            pos.iter()
+                .all(|q| (0..3).all(|i| (-1e-14..=1.0 + 1e-14).contains(&q[i])))
+        );
+        // The cells fill the cube: their volumes sum to 1.
+        let refined = Lattice::new(pos.clone(), topo.clone()).unwrap();
+        let vol: f64 = refined.cell_volumes().unwrap().iter().sum();
+        assert!(
+            (vol - 1.0).abs() < 1e-12,
+            "level {k}: cells fill {vol}, not 1"
+        );
+    }
+}
+
+/// Interior refined control points of a regular grid are the knot-inserted
+/// tricubic B-spline control points: their limit (mask (1,4,1)/6 per axis)
+/// is the B-spline volume at their parameter, evaluated directly.
+#[test]
+fn a_regular_grid_interior_reproduces_the_tricubic_bspline_volume() {
+    let n = [6usize, 6, 6];
+    let regular = box_grid(p(0.0, 0.0, 0.0), p(6.0, 6.0, 6.0), n).unwrap();
+    let mut rng = Rng::new(11);
+    let ctrl: Vec<Point3> = regular
+        .positions
+        .iter()
+        .map(|q| q + 0.3 * rng.vector())
+        .collect();
+    let levels = 2;
+    let h = LatticeHierarchy::new(&regular, levels).unwrap();
+    let s = h.stencil_to_level(levels).unwrap();
+    let grid_pos = s.apply(&regular.positions).unwrap();
+    let refined = s.apply(&ctrl).unwrap();
+    let scale = (1 << levels) as f64;
+    // Index refined vertices by their (exact, in the interior) grid position.
+    let m = 6 * (1 << levels);
+    let mut index = vec![usize::MAX; (m + 1) * (m + 1) * (m + 1)];
+    for (v, q) in grid_pos.iter().enumerate() {
+        let ijk = [q.x * scale, q.y * scale, q.z * scale];
+        if ijk.iter().all(|x| (x - x.round()).abs() < 1e-9) {
+            let [i, j, k] = ijk.map(|x| x.round() as usize);
+            index[i + (m + 1) * (j + (m + 1) * k)] = v;
+        }
+    }
+    let mut checked = 0;
+    let mut worst: f64 = 0.0;
+    // Parameters in [2, 4]: the support [1, 5] holds only interior vertices.
+    for k in 2 * (1 << levels)..=4 * (1 << levels) {
+        for j in 2 * (1 << levels)..=4 * (1 << levels) {
+            for i in 2 * (1 << levels)..=4 * (1 << levels) {
+                let mut limit = Point3::origin();
+                for (dk, dj, di) in (0..27).map(|t| (t / 9, (t / 3) % 3, t % 3)) {
+                    let w = cubic_bspline(di as f64 - 1.0)
+                        * cubic_bspline(dj as f64 - 1.0)
+                        * cubic_bspline(dk as f64 - 1.0);
+                    let id = (i + di - 1) + (m + 1) * ((j + dj - 1) + (m + 1) * (k + dk - 1));
+                    assert_ne!(index[id], usize::MAX, "grid point {i},{j},{k} not found");
+                    limit.coords += w * refined[index[id]].coords;
+                }
+                let t = [i as f64 / scale, j as f64 / scale, k as f64 / scale];
+                let exact = tricubic(&ctrl, n, t);
+                worst = worst.max((limit - exact).norm());
+                checked += 1;
+            }
+        }
+    }
+    assert_eq!(checked, 9 * 9 * 9);
+    assert!(
+        worst < 1e-12,
+        "refined grid differs from the tricubic B-spline by {worst}"
+    );
+}
+
+#[test]
+fn type_n_cells_appear_only_at_valence_n_vertices_and_double() {
+    let h = LatticeHierarchy::new(&pyramid(), 3).unwrap();
+    for k in 1..=3 {
+        let t = h.level(k).type_n.as_ref().unwrap();
+        let count = |n: usize| (0..t.len()).filter(|&c| t.valence(c) == n).count();
+        // The pyramid has four valence-3 base vertices and a valence-4 apex.
+        assert_eq!(count(4), 1 << (k - 1), "level {k}: type-4 cells");
+        assert_eq!(
+            count(3) + count(4),
+            t.len(),
+            "level {k}: only types 3 and 4"
+        );
+        for c in 0..t.len() {
+            assert_eq!(t.hexahedron(c).is_some(), t.valence(c) == 3);
+        }
+    }
+    let cyl = LatticeHierarchy::new(&cylinder(1.0, 1.0, 6, 1).unwrap(), 1).unwrap();
+    let t = cyl.level(1).type_n.as_ref().unwrap();
+    assert!(
+        (0..t.len()).all(|c| t.valence(c) == 3),
+        "prism corners have valence 3"
+    );
+}
+
+#[test]
+fn builders_make_valid_lattices() {
+    let cyl = cylinder(1.0, 2.0, 8, 3).unwrap();
+    assert_eq!(cyl.topology.num_cells(), 9 * 3);
+    assert_eq!(cyl.num_vertices(), 16 * 4);
+    let sq = PolyMesh::from_faces(
+        vec![
+            p(0.0, 0.0, 0.0),
+            p(1.0, 0.0, 0.0),
+            p(1.0, 1.0, 0.0),
+            p(0.0, 1.0, 0.0),
+        ],
+        &[vec![0, 1, 2, 3]],
+    )
+    .unwrap();
+    let bar = extrude(&sq, Vector3::new(0.0, 0.0, 1.0), 4).unwrap();
+    assert_eq!(bar.topology.num_cells(), 4);
+    assert_eq!(bar.topology.boundary_faces().len(), 4 * 4 + 2);
+    let vol: f64 = bar.cell_volumes().unwrap().iter().sum();
+    assert!((vol - 4.0).abs() < 1e-12);
+    // Cell by cell: a cube and two prisms attached face to face.
+    let mut b = LatticeBuilder::default();
+    let ids: Vec<u32> = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+        .iter()
+        .map(|&(x, y)| b.add_vertex(p(x, y, 0.0)))
+        .collect();
+    let top = b.attach_cell(&ids, Vector3::new(0.0, 0.0, 1.0)).unwrap();
+    let top = b.attach_cell(&top, Vector3::new(0.0, 0.0, 1.0)).unwrap();
+    b.attach_cell(&top, Vector3::new(0.2, 0.0, 1.0)).unwrap();
+    let l = b.build().unwrap();
+    assert_eq!(l.topology.num_cells(), 3);
+    assert_eq!(l.topology.boundary_faces().len(), 3 * 4 + 2);
+    // Automatic tags of a box: 8 corners, 12 · 1 sharp edges.
+    let tags = &unit_cube().tags;
+    assert_eq!(tags.corners.iter().filter(|c| **c).count(), 8);
+    assert_eq!(tags.sharp_edges.iter().filter(|c| **c).count(), 12);
+    let g = box_grid(p(0.0, 0.0, 0.0), p(1.0, 1.0, 1.0), [2, 2, 2]).unwrap();
+    assert_eq!(g.tags.corners.iter().filter(|c| **c).count(), 8);
+    assert_eq!(g.tags.sharp_edges.iter().filter(|c| **c).count(), 24);
+}
+
+fn topo_error(faces: &[Vec<u32>], cells: &[Vec<u32>], n: usize) -> String {
+    LatticeTopology::new(n, faces, cells)
+        .unwrap_err()
+        .to_string()
+}
+
+#[test]
+fn bad_lattices_are_refused_naming_the_element() {
+    let hexf: Vec<Vec<u32>> = subdyn::lattice::HEX_FACES
+        .iter()
+        .map(|f| f.iter().map(|&i| i as u32).collect())
+        .collect();
+    // Open cell: a face missing.
+    let e = topo_error(&hexf[..5], &[vec![0, 1, 2, 3, 4]], 8);
+    assert!(e.contains("cell 0") && e.contains("not closed"), "{e}");
+    // A face in three cells.
+    let e = topo_error(&hexf, &vec![vec![0, 1, 2, 3, 4, 5]; 3], 8);
+    assert!(e.contains("more than two cells"), "{e}");
+    // Out of range, repeated face, degenerate face.
+    assert!(topo_error(&[vec![0, 1, 9]], &[vec![0]], 4).contains("face 0: vertex 9 out of range"));
+    assert!(topo_error(&[vec![0, 1, 2], vec![2, 1, 0]], &[vec![0]], 3).contains("repeats face 0"));
+    assert!(topo_error(&[vec![0, 1, 1]], &[vec![0]], 3).contains("distinct"));
+    // Two cubes that share nothing.
+    let mut pos: Vec<Point3> = Vec::new();
+    for dx in [0.0, 5.0] {
+        for &(x, y, z) in &[
+            (0., 0., 0.),
+            (1., 0., 0.),
+            (1., 1., 0.),
+            (0., 1., 0.),
+            (0., 0., 1.),
+            (1., 0., 1.),
+            (1., 1., 1.),
+            (0., 1., 1.),
+        ] {
+            pos.push(p(x + dx, y, z));
+        }
+    }
+    let e = hexahedra(
+        pos.clone(),
+        &[[0, 1, 2, 3, 4, 5, 6, 7], [8, 9, 10, 11, 12, 13, 14, 15]],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("cell 1") && e.contains("not connected"), "{e}");
+    // A flat cell and a NaN.
+    let mut flat = pos[..8].to_vec();
+    for q in &mut flat[4..] {
+        q.z = 0.0;
+    }
+    let e = hexahedra(flat, &[[0, 1, 2, 3, 4, 5, 6, 7]])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("cell 0: degenerate"), "{e}");
+    let mut nan = pos[..8].to_vec();
+    nan[3].y = f64::NAN;
+    let e = hexahedra(nan, &[[0, 1, 2, 3, 4, 5, 6, 7]])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("vertex 3") && e.contains("finite"), "{e}");
+}
+
+#[test]
+fn lattice_json_round_trips_and_reports_bad_files() {
+    use std::path::Path;
+    use subdyn::io::{lattice_from_json, lattice_to_json, read_lattice, write_lattice};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cyl.json");
+    let cyl = cylinder(1.0, 2.0, 5, 2).unwrap();
+    write_lattice(&path, &cyl).unwrap();
+    let back = read_lattice(&path).unwrap();
+    assert_eq!((&back.topology, &back.tags), (&cyl.topology, &cyl.tags));
+    assert!(common::max_pairwise(&back.positions, &cyl.positions) < 1e-15);
+    // Manual tags survive.
+    let mut tagged = unit_cube();
+    tagged.tags.corners = vec![false; 8];
+    let back = lattice_from_json(lattice_to_json(&tagged).as_bytes(), Path::new("t.json")).unwrap();
+    assert_eq!(back.tags, tagged.tags);
+    let hex = r#"{"vertices": [[0,0,0],[1,0,0],[0,1,0],[1,1,0],[0,0,1],[1,0,1],[0,1,1],[1,1,1]],
+                  "hexahedra": [[0,1,3,2,4,5,7,6]]}"#;
+    let lat = lattice_from_json(hex.as_bytes(), Path::new("h.json")).unwrap();
+    assert_eq!(lat.topology, unit_cube().topology);
+    let bad = |text: &str| {
+        lattice_from_json(text.as_bytes(), Path::new("bad.json"))
+            .unwrap_err()
+            .to_string()
+    };
+    let e = bad("{\"vertices\": [[0,0,0],\n [1,0]]}");
+    assert!(e.starts_with("bad.json:2:"), "{e}");
+    let e = bad(r#"{"vertices": [[0,0,0]]}"#);
+    assert!(e.contains("expected either"), "{e}");
+    let e = bad(&hex.replace("[0,1,3,2,4,5,7,6]", "[0,1,3,2,4,5,7,60]"));
+    assert!(e.contains("bad.json") && e.contains("out of range"), "{e}");
+    let e = bad(&hex.replace("\"hexahedra\"", "\"hexahedron\""));
+    assert!(e.contains("unknown field"), "{e}");
+}
+
+#[test]
+fn box_lattices_enclose_the_model_and_cull_empty_cells() {
+    use subdyn::lattice::{BoxKind, BoxLatticeParams, box_lattice};
+    // Points on a thin rotated slab.
+    let mut rng = Rng::new(21);
+    let rot = nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.4, -0.7, 0.2));
+    let pts: Vec<Point3> = (0..500)
+        .map(|_| {
+            rot * p(
+                rng.uniform(-2.0, 2.0),
+                rng.uniform(-1.0, 1.0),
+                rng.uniform(-0.1, 0.1),
+            )
+        })
+        .collect();
+    let volume = |kind, levels, cull| {
+        let params = BoxLatticeParams {
+            kind,
+            octree_levels: levels,
+            cull,
+            ..Default::default()
+        };
+        let lat = box_lattice(&pts, &params).unwrap();
+        let v: f64 = lat.cell_volumes().unwrap().iter().sum();
+        (lat, v)
+    };
+    let (aabb, v_aabb) = volume(BoxKind::Aabb, 0, true);
+    let (obb, v_obb) = volume(BoxKind::Obb, 0, true);
+    assert_eq!(aabb.topology.num_cells(), 1);
+    assert!(
+        v_obb < 0.5 * v_aabb,
+        "OBB {v_obb} not tighter than AABB {v_aabb}"
+    );
+    // The OBB is the slab grown by 5 % of the diagonal: ≈ (4 + 2m)(2 + 2m)(0.2 + 2m).
+    let m = 0.05 * common::diag(&pts);
+    let expect = (4.0 + 2.0 * m) * (2.0 + 2.0 * m) * (0.2 + 2.0 * m);
+    assert!(
+        (v_obb - expect).abs() < 0.1 * expect,
+        "OBB volume {v_obb}, expected ≈ {expect}"
+    );
+    let ffd = subdyn::ffd::Ffd::new(
+        &obb,
+        &pts,
+        &subdyn::ffd::FfdParams {
+            levels: 1,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(ffd.report.outside, 0, "OBB lattice misses vertices");
+    let (full, _) = volume(BoxKind::Obb, 3, false);
+    let (culled, _) = volume(BoxKind::Obb, 3, true);
+    assert_eq!(full.topology.num_cells(), 512);
+    assert!(culled.topology.num_cells() < 512 && culled.topology.num_cells() >= 64);
+    assert!(
+        box_lattice(
+            &pts,
+            &BoxLatticeParams {
+                octree_levels: 9,
+                ..Default::default()
+            }
+        )
+        .is_err()
+    );
+    assert!(box_lattice(&[], &BoxLatticeParams::default()).is_err());
+}
+
+#[test]
+fn lattice_cli_writes_a_readable_lattice_and_refuses_bad_input() {
+    use std::process::Command;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cube = subdyn::examples::cube();
+    subdyn::io::write_mesh(d.join("m.obj"), &cube, None).unwrap();
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_subdyn"))
+            .args(args)
+            .current_dir(d)
+            .output()
+            .unwrap()
+    };
+    let out = run(&[
+        "lattice",
+        "m.obj",
+        "-o",
+        "lat.json",
+        "--box",
+        "obb",
+        "--octree-levels",
+        "2",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lat = subdyn::io::read_lattice(d.join("lat.json")).unwrap();
+    assert!(lat.topology.num_cells() > 8 && lat.topology.num_cells() <= 64);
+    for (args, needle) in [
+        (vec!["lattice", "m.obj", "-o", "lat.obj"], "json"),
+        (
+            vec!["lattice", "m.obj", "-o", "x.json", "--octree-levels", "12"],
+            "octree levels",
+        ),
+        (
+            vec!["lattice", "missing.obj", "-o", "x.json"],
+            "missing.obj",
+        ),
+    ] {
+        let out = run(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(needle), "`{needle}` not in {err}");
+        assert!(!d.join("x.json").exists());
+    }
+}
