@@ -37,8 +37,9 @@ pub struct RecoverArgs {
     #[arg(short, long, value_name = "SHAPE", default_value = "shape.obj")]
     pub output: PathBuf,
     /// Grow the model from a small sphere at this world point (x,y,z), which
-    /// must lie inside the object. Genus 0 only.
-    #[arg(long, value_name = "x,y,z", value_parser = parse_triple, conflicts_with_all = ["auto", "init"])]
+    /// must lie inside the object (genus 0 only); with --auto, start from the
+    /// connected component holding this point instead of the largest.
+    #[arg(long, value_name = "x,y,z", value_parser = parse_triple, allow_hyphen_values = true, conflicts_with = "init")]
     pub seed: Option<[f64; 3]>,
     /// Start from the boundary of the largest connected component above the
     /// inside level (the iso-value, or Otsu's threshold); any genus. The default.
@@ -65,7 +66,7 @@ pub struct RecoverArgs {
     #[arg(long, value_name = "sx,sy,sz", value_parser = parse_triple)]
     pub spacing: Option<[f64; 3]>,
     /// World position of voxel (0,0,0) for formats without it.
-    #[arg(long, value_name = "ox,oy,oz", value_parser = parse_triple)]
+    #[arg(long, value_name = "ox,oy,oz", value_parser = parse_triple, allow_hyphen_values = true)]
     pub origin: Option<[f64; 3]>,
     /// Stop when the 95th percentile of the surface-to-boundary offsets is below this many voxels.
     #[arg(long, value_name = "VOXELS", default_value_t = 0.5)]
@@ -225,7 +226,7 @@ fn initial_model(
     prepared: &PreparedVolume,
 ) -> anyhow::Result<(PolyMesh, serde_json::Value)> {
     let volume = &prepared.smoothed;
-    if let Some(s) = args.seed {
+    if let Some(s) = args.seed.filter(|_| !args.auto) {
         let p = Point3::new(s[0], s[1], s[2]);
         if !volume.contains(&p) {
             let (lo, hi) = volume.world_bounds();
@@ -278,11 +279,12 @@ fn initial_model(
             args.resolution
         );
     }
+    let seed = args.seed.map(|s| Point3::new(s[0], s[1], s[2]));
     let cage = component_cage(
         volume,
         prepared.inside_level,
         !args.dark,
-        None,
+        seed,
         args.resolution,
     )?;
     let value = json!({"method": "auto", "component_voxels": cage.voxels,
