@@ -99,11 +99,6 @@ impl Volume {
         &self.data
     }
 
-    /// Mutable samples, x fastest (the grid is unchanged).
-    pub fn data_mut(&mut self) -> &mut [f32] {
-        &mut self.data
-    }
-
     /// A volume on the same grid with other samples.
     pub fn with_data(&self, data: Vec<f32>) -> Result<Self> {
         Self::with_affine(self.dims, data, self.linear, self.origin)

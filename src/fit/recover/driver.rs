@@ -145,10 +145,9 @@ pub fn recover_shape(
         // `quadrature`'s quadtree leaves, which cost ten times more to
         // assemble for a vanishing share of the area.
         let q = patch_samples(&qtable, params.quadrature_order)?;
-        let fs = &q;
-        let j = fs.rows.p.compose(s)?;
-        let ju = fs.rows.du.compose(s)?;
-        let jv = fs.rows.dv.compose(s)?;
+        let j = q.rows.p.compose(s)?;
+        let ju = q.rows.du.compose(s)?;
+        let jv = q.rows.dv.compose(s)?;
         let area: Real = q.weights.iter().sum();
         let material = MaterialParams {
             alpha11: params.tension / area,
@@ -204,7 +203,7 @@ pub fn recover_shape(
                             xs[i] + range * field.balloon_direction(&xs[i], &n, o == Offset::Inside)
                         }
                     };
-                    (target, da * fs.weights[i], o)
+                    (target, da * q.weights[i], o)
                 })
                 .collect();
             let total: Real = found.iter().map(|f| f.1).sum();
@@ -292,7 +291,7 @@ pub fn recover_shape(
             level,
             control_points: mesh.num_vertices(),
             faces: mesh.num_faces(),
-            samples: fs.weights.len(),
+            samples: q.weights.len(),
             steps,
             cg_iterations,
             seconds: level_start.elapsed().as_secs_f64(),
