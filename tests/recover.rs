@@ -54,7 +54,7 @@ fn a_seed_grows_to_a_sphere_iso_surface() {
     };
     let prepared = prepare_volume(&vol, &params).unwrap();
     let init = seed_cage(c + subdyn::math::Vector3::new(2.0, -1.0, 1.0), 3.0).unwrap();
-    let out = recover_shape(&prepared, &init, &params, &mut |_, _, _| {}).unwrap();
+    let out = recover_shape(&prepared, &init, &[], &params, &mut |_, _, _| {}).unwrap();
     for l in &out.report.levels {
         println!(
             "level {} cps {} samples {} steps {} p95 {:.3} vox unresolved {:.3} {:.2}s",
@@ -85,7 +85,7 @@ fn a_torus_is_recovered_from_its_thresholded_component_with_edges() {
     let prepared = prepare_volume(&vol, &params).unwrap();
     let cage = component_cage(&prepared.smoothed, prepared.inside_level, true, None, 12).unwrap();
     assert_eq!(cage.genus, 1);
-    let out = recover_shape(&prepared, &cage.mesh, &params, &mut |_, _, _| {}).unwrap();
+    let out = recover_shape(&prepared, &cage.mesh, &[], &params, &mut |_, _, _| {}).unwrap();
     for l in &out.report.levels {
         println!(
             "level {} cps {} samples {} steps {} p95 {:.3} vox unresolved {:.3} {:.2}s",
@@ -201,4 +201,60 @@ fn the_recover_verb_writes_the_shape_report_and_slices_and_rejects_bad_input() {
         );
         assert!(!dir.path().join("bad.obj").exists());
     }
+}
+
+#[test]
+fn user_placed_points_pull_the_surface_where_the_image_says_otherwise() {
+    // The image shows a ball of radius 9; ten points placed on radius 11
+    // around its upper half pull that half out, more with a larger weight.
+    let c = Point3::new(16.0, 16.0, 16.0);
+    let vol = sdf_volume([32, 32, 32], [1.0; 3], move |p: Point3| {
+        (p - c).norm() - 9.0
+    });
+    let points: Vec<Point3> = (0..10)
+        .map(|i| {
+            let a = i as Real * std::f64::consts::TAU / 10.0;
+            c + 11.0 * subdyn::math::Vector3::new(0.6 * a.cos(), 0.6 * a.sin(), 0.8)
+        })
+        .collect();
+    let top_radius = |weight: Real, with_points: bool| {
+        let params = RecoverParams {
+            boundary: BoundaryModel::Iso { value: 0.5 },
+            points_weight: weight,
+            // Finer levels let single points raise spikes (see the issue
+            // note: point forces are not spread by a kernel yet).
+            max_level: 0,
+            ..Default::default()
+        };
+        let prepared = prepare_volume(&vol, &params).unwrap();
+        let init = seed_cage(c, 4.0).unwrap();
+        let pts = if with_points { &points[..] } else { &[] };
+        let out = recover_shape(&prepared, &init, pts, &params, &mut |_, _, _| {});
+        let out = out.unwrap_or_else(|e| panic!("weight {weight} points {with_points}: {e}"));
+
+        let refiner = Refiner::new(&out.control, &RefineOptions::default()).unwrap();
+        let (tess, _) = tessellate(&refiner, &out.control.positions, 4).unwrap();
+        // Largest distance from the centre among surface points near the
+        // direction of the placed points.
+        tess.positions
+            .iter()
+            .filter(|p| (*p - c).normalize().z > 0.75)
+            .map(|p| (p - c).norm())
+            .fold(0.0, Real::max)
+    };
+    let none = top_radius(1.0, false);
+    let weak = top_radius(0.2, true);
+    let strong = top_radius(5.0, true);
+    println!("top radius: image only {none:.3}, weight 0.2 {weak:.3}, weight 5 {strong:.3}");
+    assert!((none - 9.0).abs() < 0.3, "{none}");
+    assert!(
+        weak > none + 0.1 && strong > weak + 0.1,
+        "{none} {weak} {strong}"
+    );
+    assert!(strong < 11.2, "{strong}");
+    let bad = [Point3::new(f64::NAN, 0.0, 0.0)];
+    let params = RecoverParams::default();
+    let prepared = prepare_volume(&vol, &params).unwrap();
+    let init = seed_cage(c, 4.0).unwrap();
+    assert!(recover_shape(&prepared, &init, &bad, &params, &mut |_, _, _| {}).is_err());
 }

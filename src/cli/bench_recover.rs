@@ -113,7 +113,7 @@ pub fn bench_recover(args: &BenchRecoverArgs) -> anyhow::Result<()> {
     let mut on_step = |level: usize, step: usize, _e: f64| {
         progress.stage(format!("level {level}, step {step}"));
     };
-    let result = recover_shape(&prepared, &cage.mesh, &params, &mut on_step)?;
+    let result = recover_shape(&prepared, &cage.mesh, &[], &params, &mut on_step)?;
     drop(progress);
     let evolution_s: f64 = result.report.levels.iter().map(|l| l.seconds).sum();
     let refiner = Refiner::new(&result.control, &RefineOptions::default())?;

@@ -13,7 +13,7 @@ use subdyn::fit::recover::{
     seed_cage,
 };
 use subdyn::forces::BoundaryModel;
-use subdyn::io::{VolumeReadOptions, read_volume, write_mesh};
+use subdyn::io::{VolumeReadOptions, read_points, read_volume, write_mesh};
 use subdyn::limit::tessellate;
 use subdyn::math::{Point3, Real};
 use subdyn::mesh::PolyMesh;
@@ -80,6 +80,14 @@ pub struct RecoverArgs {
     /// Radius of the --seed sphere in voxels.
     #[arg(long, value_name = "VOXELS", default_value_t = 3.0)]
     pub seed_radius: f64,
+    /// User-placed boundary points (any point file: .xyz, .ply, .obj, .off),
+    /// each pulling its closest point of the surface with a spring: for
+    /// boundaries the image does not show (the paper's caudate nucleus).
+    #[arg(long, value_name = "FILE")]
+    pub points: Option<PathBuf>,
+    /// Total stiffness of the --points springs relative to the image springs.
+    #[arg(long, value_name = "W", default_value_t = RecoverParams::default().points_weight)]
+    pub points_weight: f64,
     /// Bending weight λ_b of the thin plate.
     #[arg(long, value_name = "λ", default_value_t = RecoverParams::default().bending)]
     pub bending: f64,
@@ -135,9 +143,18 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
         tolerance_voxels: args.tol,
         max_level: args.max_level,
         bending: args.bending,
+        points_weight: args.points_weight,
         ..Default::default()
     };
     params.check()?;
+    let points = match &args.points {
+        Some(path) => {
+            read_points(path)
+                .map_err(|e| about_file(e, path))?
+                .positions
+        }
+        None => Vec::new(),
+    };
     let progress = Progress::new(args.quiet);
     progress.stage(format!("reading {}", args.input.display()));
     let t = Instant::now();
@@ -162,7 +179,7 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     let mut on_step = |level: usize, step: usize, energy: f64| {
         progress.stage(format!("level {level}, step {step}: energy {energy:.4e}"));
     };
-    let result = recover_shape(&prepared, &init, &params, &mut on_step).map_err(|e| {
+    let result = recover_shape(&prepared, &init, &points, &params, &mut on_step).map_err(|e| {
         anyhow::Error::new(e).context(format!("recovering from {}", args.input.display()))
     })?;
     progress.stage(format!("writing {}", args.output.display()));

@@ -22,8 +22,10 @@ use crate::dynamics::{
 };
 use crate::error::{Error, Result};
 use crate::fit::ErrorStats;
-use crate::forces::{BoundaryModel, ImageField, Offset, inflation_force, row_springs};
-use crate::limit::PatchTable;
+use crate::forces::{
+    BoundaryModel, ImageField, Offset, inflation_force, row_springs, spring_system,
+};
+use crate::limit::{ClosestPointEngine, ClosestPointParams, PatchTable};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::PolyMesh;
 use crate::stencil::StencilTable;
@@ -102,16 +104,21 @@ pub struct RecoverResult {
 }
 
 /// The solve step: evolves `init` (a closed, outward-oriented control mesh
-/// inside or around the object) to the boundary in `prepared`.
-/// `progress(level, step, energy)` is called after every step.
+/// inside or around the object) to the boundary in `prepared`. `points` are
+/// user-placed boundary points (world coordinates; may be empty), each
+/// pulling its closest point of the limit surface with a spring, for parts
+/// of the boundary the image does not show (Qin et al. 1998, the caudate
+/// nucleus). `progress(level, step, energy)` is called after every step.
 pub fn recover_shape(
     prepared: &PreparedVolume,
     init: &PolyMesh,
+    points: &[Point3],
     params: &RecoverParams,
     progress: &mut dyn FnMut(usize, usize, Real),
 ) -> Result<RecoverResult> {
     params.check()?;
     crate::mesh::check_finite(&init.positions)?;
+    crate::mesh::check_finite(points)?;
     let start = Instant::now();
     let field = ImageField {
         smoothed: &prepared.smoothed,
@@ -178,6 +185,16 @@ pub fn recover_shape(
         } else {
             params.max_steps
         };
+        let mut engine = if points.is_empty() {
+            None
+        } else {
+            Some(ClosestPointEngine::new(
+                &refiner,
+                &mesh.positions,
+                &ClosestPointParams::default(),
+            )?)
+        };
+        let point_k = vec![params.points_weight / points.len().max(1) as Real; points.len()];
         let mut p = mesh.positions.clone();
         let mut energy: Vec<Real> = Vec::new();
         let (mut steps, mut cg_iterations, mut still) = (0, 0, false);
@@ -220,7 +237,17 @@ pub fn recover_shape(
             }
             let targets: Vec<Point3> = found.iter().map(|f| f.0).collect();
             let kw: Vec<Real> = found.iter().map(|f| f.1 / total).collect();
-            let springs = row_springs(&j, &xs, &targets, &kw)?;
+            let mut springs = row_springs(&j, &xs, &targets, &kw)?;
+            if let Some(engine) = &mut engine {
+                engine.set_positions(&p)?;
+                let closest = engine.closest_points(points)?;
+                let user = spring_system(engine, points, &closest, &point_k)?;
+                springs.matrix = springs.matrix.linear_combination(1.0, &user.matrix, 1.0)?;
+                for (r, u) in springs.rhs.iter_mut().zip(&user.rhs) {
+                    r.coords += u.coords;
+                }
+                springs.energy += user.energy;
+            }
             let kp = k.apply(&p)?;
             let e = springs.energy
                 + 0.5

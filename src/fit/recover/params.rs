@@ -55,6 +55,11 @@ pub struct RecoverParams {
     pub inflation: Real,
     /// Gauss-Legendre points per side of every level-1 piece (default 3).
     pub quadrature_order: usize,
+    /// Total stiffness of the user-placed boundary points (the caudate
+    /// experiment's springs, each point to its closest point of the limit
+    /// surface) relative to the image springs, whose stiffness sums to 1
+    /// (default 1; only used when points are given).
+    pub points_weight: Real,
 }
 
 impl Default for RecoverParams {
@@ -76,6 +81,7 @@ impl Default for RecoverParams {
             damping: 0.05,
             inflation: 0.0,
             quadrature_order: 3,
+            points_weight: 1.0,
         }
     }
 }
@@ -138,6 +144,7 @@ impl RecoverParams {
         non_negative("tension", self.tension)?;
         non_negative("bending", self.bending)?;
         positive("damping", self.damping)?;
+        non_negative("points weight", self.points_weight)?;
         if !self.inflation.is_finite() {
             return Err(Error::Input("inflation must be finite".into()));
         }
