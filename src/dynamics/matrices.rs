@@ -43,6 +43,22 @@ pub struct MaterialParams {
     pub beta22: Real,
 }
 
+impl MaterialParams {
+    /// The fitting drivers' thin plate under tension, with weights relative
+    /// to data terms that sum to 1 over the surface: `α11 = α22 = λ_t / A`,
+    /// `β11 = β22 = λ_b / A`, `β12 = 2 λ_b / A` (`A` the parameter area).
+    pub fn thin_plate(tension: Real, bending: Real, area: Real) -> MaterialParams {
+        MaterialParams {
+            alpha11: tension / area,
+            alpha22: tension / area,
+            beta11: bending / area,
+            beta12: 2.0 * bending / area,
+            beta22: bending / area,
+            ..Default::default()
+        }
+    }
+}
+
 impl Default for MaterialParams {
     fn default() -> Self {
         MaterialParams {

@@ -87,14 +87,7 @@ pub fn fit_point_cloud(
         let q = quadrature(&qtable, params.quadrature_order)?;
         let s = qtable.to_level();
         let area: Real = q.weights.iter().sum();
-        let material = MaterialParams {
-            alpha11: params.tension / area,
-            alpha22: params.tension / area,
-            beta11: params.bending / area,
-            beta12: 2.0 * params.bending / area,
-            beta22: params.bending / area,
-            ..Default::default()
-        };
+        let material = MaterialParams::thin_plate(params.tension, params.bending, area);
         let k = stiffness_matrix(&q, s, &material)?;
         let d = damping_matrix(&q, s, None, params.damping / area)?;
         let kd = k.linear_combination(1.0, &d, 1.0)?;
@@ -145,12 +138,7 @@ pub fn fit_point_cloud(
                 let m = xs.len() as Real;
                 let ks: Vec<Real> = ws.iter().map(|w| params.surface_weight * w / m).collect();
                 let targets: Vec<Point3> = near.iter().map(|n| n.0).collect();
-                let back = row_springs(&centres, &xs, &targets, &ks)?;
-                springs.matrix = springs.matrix.linear_combination(1.0, &back.matrix, 1.0)?;
-                for (r, b) in springs.rhs.iter_mut().zip(&back.rhs) {
-                    r.coords += b.coords;
-                }
-                springs.energy += back.energy;
+                springs.add(&row_springs(&centres, &xs, &targets, &ks)?)?;
             }
             let kp = k.apply(&p)?;
             let e = springs.energy

@@ -25,6 +25,26 @@ pub struct SpringSystem {
     pub energy: Real,
 }
 
+impl SpringSystem {
+    /// Adds another spring system over the same control points (matrices,
+    /// loads and energies add).
+    pub fn add(&mut self, other: &SpringSystem) -> Result<()> {
+        self.matrix = self.matrix.linear_combination(1.0, &other.matrix, 1.0)?;
+        if self.rhs.len() != other.rhs.len() {
+            return Err(Error::Input(format!(
+                "springs over {} and {} control points",
+                self.rhs.len(),
+                other.rhs.len()
+            )));
+        }
+        for (r, o) in self.rhs.iter_mut().zip(&other.rhs) {
+            r.coords += o.coords;
+        }
+        self.energy += other.energy;
+        Ok(())
+    }
+}
+
 /// Springs from `points[i]` to `closest[i]` with stiffness `k[i]` (springs
 /// with `k = 0` are skipped).
 pub fn spring_system(

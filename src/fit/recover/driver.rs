@@ -156,14 +156,7 @@ pub fn recover_shape(
         let ju = q.rows.du.compose(s)?;
         let jv = q.rows.dv.compose(s)?;
         let area: Real = q.weights.iter().sum();
-        let material = MaterialParams {
-            alpha11: params.tension / area,
-            alpha22: params.tension / area,
-            beta11: params.bending / area,
-            beta12: 2.0 * params.bending / area,
-            beta22: params.bending / area,
-            ..Default::default()
-        };
+        let material = MaterialParams::thin_plate(params.tension, params.bending, area);
         let k = stiffness_matrix(&q, s, &material)?;
         // Damping on the limit surface is blind to control-point modes that
         // barely move it (a checkerboard over a coarse cage); a small
@@ -241,12 +234,7 @@ pub fn recover_shape(
             if let Some(engine) = &mut engine {
                 engine.set_positions(&p)?;
                 let closest = engine.closest_points(points)?;
-                let user = spring_system(engine, points, &closest, &point_k)?;
-                springs.matrix = springs.matrix.linear_combination(1.0, &user.matrix, 1.0)?;
-                for (r, u) in springs.rhs.iter_mut().zip(&user.rhs) {
-                    r.coords += u.coords;
-                }
-                springs.energy += user.energy;
+                springs.add(&spring_system(engine, points, &closest, &point_k)?)?;
             }
             let kp = k.apply(&p)?;
             let e = springs.energy
