@@ -8,19 +8,14 @@
 //! `../shared/data/scans/bun045.ply` is used when present, skipped with a note
 //! otherwise.
 
+mod common;
+
+use common::run_subdyn;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use serde_json::Value;
-
-/// Runs the `subdyn` binary with `args` in `dir`.
-fn subdyn(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_subdyn"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the subdyn binary runs")
-}
 
 fn stdout(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
@@ -101,7 +96,7 @@ fn torus_obj(n: usize, m: usize) -> String {
 
 /// Runs `info --json` on `dir/name` and parses the result.
 fn info_json(dir: &Path, name: &str) -> Value {
-    let out = ok(&subdyn(dir, &["info", name, "--json"]));
+    let out = ok(&run_subdyn(dir, &["info", name, "--json"]));
     serde_json::from_str(out.trim()).expect("info --json prints one JSON object")
 }
 
@@ -142,7 +137,7 @@ fn assert_clean_failure(dir: &Path, out: &Output, needles: &[&str], inputs: &[&s
 fn bad_input(name: &str, bytes: &[u8], needles: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     write(dir.path(), name, bytes);
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &["subdivide", name, "-o", "out.obj", "--levels", "1"],
     );
@@ -154,7 +149,7 @@ fn bad_input(name: &str, bytes: &[u8], needles: &[&str]) {
 #[test]
 fn subdivide_embedded_cube_three_levels() {
     let dir = tempfile::tempdir().unwrap();
-    let out = ok(&subdyn(
+    let out = ok(&run_subdyn(
         dir.path(),
         &[
             "subdivide",
@@ -197,7 +192,7 @@ fn subdivide_file_two_levels_to_every_format() {
     let dir = tempfile::tempdir().unwrap();
     copy(dir.path(), "opensubdiv/cube.obj", "cube.obj");
     for out in ["l2.obj", "l2.ply", "l2.off", "l2.obj.gz"] {
-        ok(&subdyn(
+        ok(&run_subdyn(
             dir.path(),
             &[
                 "subdivide",
@@ -213,7 +208,7 @@ fn subdivide_file_two_levels_to_every_format() {
         assert_eq!(info["vertices"], 98, "{out}");
         assert_eq!(info["faces"], 96, "{out}");
     }
-    ok(&subdyn(
+    ok(&run_subdyn(
         dir.path(),
         &["subdivide", "cube.obj", "-o", "l2.xyz", "--levels", "2"],
     ));
@@ -231,7 +226,7 @@ fn subdivide_with_creases_keeps_the_sharp_edge() {
             .iter()
             .any(|p| p[0].abs() < 1e-12 && p[1].abs() < 1e-12 && (p[2] - 0.5).abs() < 1e-12)
     };
-    ok(&subdyn(
+    ok(&run_subdyn(
         dir.path(),
         &[
             "subdivide",
@@ -244,7 +239,7 @@ fn subdivide_with_creases_keeps_the_sharp_edge() {
             "cube.creases",
         ],
     ));
-    ok(&subdyn(
+    ok(&run_subdyn(
         dir.path(),
         &["subdivide", "cube.obj", "-o", "smooth.obj", "--levels", "1"],
     ));
@@ -266,11 +261,11 @@ fn subdivide_limit_matches_limit_tessellation_extent() {
         "2",
         "--limit",
     ];
-    ok(&subdyn(
+    ok(&run_subdyn(
         dir.path(),
         &[&args[..], &["--report", "a.json"]].concat(),
     ));
-    ok(&subdyn(
+    ok(&run_subdyn(
         dir.path(),
         &[
             "subdivide",
@@ -283,7 +278,7 @@ fn subdivide_limit_matches_limit_tessellation_extent() {
             "b.json",
         ],
     ));
-    ok(&subdyn(
+    ok(&run_subdyn(
         dir.path(),
         &[
             "limit", "cube.obj", "-o", "t.obj", "--tess", "4", "--report", "c.json",
@@ -309,11 +304,11 @@ fn subdivide_limit_matches_limit_tessellation_extent() {
 #[test]
 fn subdivide_refuses_absurd_levels_before_working() {
     let dir = tempfile::tempdir().unwrap();
-    let out = subdyn(dir.path(), &["subdivide", "-o", "x.obj", "--levels", "9"]);
+    let out = run_subdyn(dir.path(), &["subdivide", "-o", "x.obj", "--levels", "9"]);
     assert_clean_failure(dir.path(), &out, &["--levels 9", "at most 8"], &[]);
     // 8 levels of a 30×30 torus would make 900 × 4⁸ ≈ 59 million faces.
     write(dir.path(), "torus.obj", torus_obj(30, 30).as_bytes());
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &["subdivide", "torus.obj", "-o", "x.obj", "--levels", "8"],
     );
@@ -333,7 +328,7 @@ fn subdivide_warns_about_isolated_vertices_unless_quiet() {
         "q.obj",
         b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 9 9 9\nf 1 2 3 4\n",
     );
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &["subdivide", "q.obj", "-o", "o.obj", "--levels", "1"],
     );
@@ -341,7 +336,7 @@ fn subdivide_warns_about_isolated_vertices_unless_quiet() {
     assert!(stderr(&out).contains("isolated"), "{}", stderr(&out));
     // The isolated vertex is carried along: 1 + 4 + 4 + 1.
     assert_eq!(obj_vertices(&dir.path().join("o.obj")).len(), 10);
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &["subdivide", "q.obj", "-o", "o.obj", "--levels", "1", "-q"],
     );
@@ -352,14 +347,14 @@ fn subdivide_warns_about_isolated_vertices_unless_quiet() {
 #[test]
 fn usage_errors_exit_with_code_two() {
     let dir = tempfile::tempdir().unwrap();
-    let out = subdyn(dir.path(), &["subdivide", "--levels", "2"]);
+    let out = run_subdyn(dir.path(), &["subdivide", "--levels", "2"]);
     assert_eq!(out.status.code(), Some(2));
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &["subdivide", "-o", "x.obj", "--boundary", "sideways"],
     );
     assert_eq!(out.status.code(), Some(2));
-    let out = subdyn(dir.path(), &["frobnicate"]);
+    let out = run_subdyn(dir.path(), &["frobnicate"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(files(dir.path()).is_empty());
 }
@@ -370,7 +365,7 @@ fn boundary_rules_differ_on_an_open_mesh() {
     copy(dir.path(), "opensubdiv/grid4_open.obj", "g.obj");
     for rule in ["edge-and-corner", "edge-only"] {
         let out = format!("{rule}.obj");
-        ok(&subdyn(
+        ok(&run_subdyn(
             dir.path(),
             &[
                 "subdivide",
@@ -459,9 +454,9 @@ fn bad_empty_file() {
 #[test]
 fn bad_missing_file() {
     let dir = tempfile::tempdir().unwrap();
-    let out = subdyn(dir.path(), &["subdivide", "nope.obj", "-o", "out.obj"]);
+    let out = run_subdyn(dir.path(), &["subdivide", "nope.obj", "-o", "out.obj"]);
     assert_clean_failure(dir.path(), &out, &["nope.obj", "no such file"], &[]);
-    let out = subdyn(dir.path(), &["info", "nope.ply"]);
+    let out = run_subdyn(dir.path(), &["info", "nope.ply"]);
     assert_clean_failure(dir.path(), &out, &["nope.ply", "no such file"], &[]);
 }
 
@@ -470,7 +465,7 @@ fn bad_unknown_extension() {
     bad_input("m.stl", b"solid x\nendsolid x\n", &["m.stl", "extension"]);
     // An unknown output extension is refused before any work.
     let dir = tempfile::tempdir().unwrap();
-    let out = subdyn(dir.path(), &["subdivide", "-o", "out.stl"]);
+    let out = run_subdyn(dir.path(), &["subdivide", "-o", "out.stl"]);
     assert_clean_failure(dir.path(), &out, &["out.stl", "extension"], &[]);
 }
 
@@ -483,7 +478,7 @@ fn bad_point_file_for_subdivide() {
 fn bad_crease_file() {
     let dir = tempfile::tempdir().unwrap();
     write(dir.path(), "c.txt", b"0 1 inf\n0 7 2\n");
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &["subdivide", "-o", "o.obj", "--creases", "c.txt"],
     );
@@ -494,7 +489,7 @@ fn bad_crease_file() {
         &["c.txt"],
     );
     write(dir.path(), "c.txt", b"0 1\n");
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &["subdivide", "-o", "o.obj", "--creases", "c.txt"],
     );
@@ -506,7 +501,7 @@ fn failed_run_keeps_the_previous_output_whole() {
     let dir = tempfile::tempdir().unwrap();
     write(dir.path(), "out.obj", b"# previous\n");
     write(dir.path(), "bad.obj", b"v 0 0 0\nf 1 2 3\n");
-    let out = subdyn(dir.path(), &["subdivide", "bad.obj", "-o", "out.obj"]);
+    let out = run_subdyn(dir.path(), &["subdivide", "bad.obj", "-o", "out.obj"]);
     assert_clean_failure(dir.path(), &out, &["bad.obj"], &["bad.obj", "out.obj"]);
     assert_eq!(
         std::fs::read(dir.path().join("out.obj")).unwrap(),
@@ -520,7 +515,7 @@ fn failed_run_keeps_the_previous_output_whole() {
 fn limit_of_closed_cube_is_watertight_with_normals() {
     let dir = tempfile::tempdir().unwrap();
     copy(dir.path(), "opensubdiv/cube.obj", "cube.obj");
-    let out = ok(&subdyn(
+    let out = ok(&run_subdyn(
         dir.path(),
         &[
             "limit",
@@ -540,7 +535,7 @@ fn limit_of_closed_cube_is_watertight_with_normals() {
     assert_eq!(info["boundary_edges"], 0, "watertight");
     assert_eq!(info["genus"], 0);
     assert_eq!(info["normals"], true);
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &["limit", "cube.obj", "-o", "x.obj", "--tess", "0"],
     );
@@ -571,7 +566,7 @@ fn info_reports_genus_of_cube_and_torus() {
     assert_eq!(torus["euler"], 0);
     assert_eq!(torus["genus"], 1);
     assert_eq!(torus["boundary_loops"], 0);
-    let text = ok(&subdyn(dir.path(), &["info", "torus.obj"]));
+    let text = ok(&run_subdyn(dir.path(), &["info", "torus.obj"]));
     assert!(text.contains("genus:                1"), "{text}");
     assert!(text.contains("components:           1"), "{text}");
 }
@@ -583,7 +578,7 @@ fn info_on_open_and_non_manifold_meshes() {
     let fan = info_json(dir.path(), "fan.obj");
     assert_eq!(fan["boundary_loops"], 1);
     assert_eq!(fan["genus"], Value::Null);
-    assert!(ok(&subdyn(dir.path(), &["info", "fan.obj"])).contains("n/a"));
+    assert!(ok(&run_subdyn(dir.path(), &["info", "fan.obj"])).contains("n/a"));
     write(
         dir.path(),
         "m.obj",
@@ -604,7 +599,7 @@ fn info_on_point_files() {
         "p.xyz",
         b"0 0 0 0 0 1\n1 0 0 0 0 1\n0 2 0 0 0 1\n1 2 3 0 0 1\n",
     );
-    let text = ok(&subdyn(dir.path(), &["info", "p.xyz"]));
+    let text = ok(&run_subdyn(dir.path(), &["info", "p.xyz"]));
     assert!(text.contains("points:               4"), "{text}");
     assert!(text.contains("normals:              yes"), "{text}");
     let p = info_json(dir.path(), "p.xyz");
@@ -632,10 +627,11 @@ fn info_on_bunny_scan_reports_40097_points() {
     }
     let dir = tempfile::tempdir().unwrap();
     let path = path.to_string_lossy().into_owned();
-    let text = ok(&subdyn(dir.path(), &["info", &path]));
+    let text = ok(&run_subdyn(dir.path(), &["info", &path]));
     assert!(text.contains("points:               40,097"), "{text}");
     let json: Value =
-        serde_json::from_str(ok(&subdyn(dir.path(), &["info", &path, "--json"])).trim()).unwrap();
+        serde_json::from_str(ok(&run_subdyn(dir.path(), &["info", &path, "--json"])).trim())
+            .unwrap();
     assert_eq!(json["points"], 40097);
 }
 
@@ -643,7 +639,7 @@ fn info_on_bunny_scan_reports_40097_points() {
 fn info_bad_input_is_one_line() {
     let dir = tempfile::tempdir().unwrap();
     write(dir.path(), "e.off", b"");
-    let out = subdyn(dir.path(), &["info", "e.off"]);
+    let out = run_subdyn(dir.path(), &["info", "e.off"]);
     assert_clean_failure(dir.path(), &out, &["e.off", "empty"], &["e.off"]);
 }
 
@@ -652,7 +648,7 @@ fn info_bad_input_is_one_line() {
 #[test]
 fn bench_subdivide_prints_json_last_line() {
     let dir = tempfile::tempdir().unwrap();
-    let out = ok(&subdyn(
+    let out = ok(&run_subdyn(
         dir.path(),
         &["bench", "subdivide", "--grid", "8", "--levels", "1"],
     ));
@@ -680,7 +676,7 @@ fn bench_subdivide_prints_json_last_line() {
 #[test]
 fn bench_closest_is_exact_and_prints_json_last_line() {
     let dir = tempfile::tempdir().unwrap();
-    let out = ok(&subdyn(
+    let out = ok(&run_subdyn(
         dir.path(),
         &[
             "bench",
@@ -711,7 +707,7 @@ fn bench_closest_is_exact_and_prints_json_last_line() {
         json["max_excess_baseline"].as_f64().unwrap() > 1e-6,
         "{last}"
     );
-    let bad = subdyn(dir.path(), &["bench", "closest", "--queries", "0"]);
+    let bad = run_subdyn(dir.path(), &["bench", "closest", "--queries", "0"]);
     assert_eq!(bad.status.code(), Some(1));
 }
 
@@ -732,7 +728,7 @@ fn sphere_xyz(n: usize) -> String {
 fn fit_writes_mesh_report_and_plot() {
     let dir = tempfile::tempdir().unwrap();
     write(dir.path(), "sphere.xyz", sphere_xyz(1500).as_bytes());
-    let out = ok(&subdyn(
+    let out = ok(&run_subdyn(
         dir.path(),
         &[
             "fit",
@@ -769,13 +765,13 @@ fn fit_writes_mesh_report_and_plot() {
 fn fit_bad_inputs_are_one_line_errors() {
     let dir = tempfile::tempdir().unwrap();
     write(dir.path(), "three.xyz", b"0 0 0\n1 0 0\n0 1 0\n");
-    let out = subdyn(dir.path(), &["fit", "three.xyz", "-o", "fit.obj"]);
+    let out = run_subdyn(dir.path(), &["fit", "three.xyz", "-o", "fit.obj"]);
     assert_clean_failure(dir.path(), &out, &["3 points"], &["three.xyz"]);
     write(dir.path(), "nan.xyz", b"0 0 0\nnan 1 0\n0 1 0\n");
-    let out = subdyn(dir.path(), &["fit", "nan.xyz", "-o", "fit.obj"]);
+    let out = run_subdyn(dir.path(), &["fit", "nan.xyz", "-o", "fit.obj"]);
     assert_clean_failure(dir.path(), &out, &["nan.xyz"], &["nan.xyz", "three.xyz"]);
     write(dir.path(), "sphere.xyz", sphere_xyz(200).as_bytes());
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &["fit", "sphere.xyz", "-o", "fit.obj", "--tol=-1"],
     );

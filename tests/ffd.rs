@@ -5,9 +5,10 @@
 mod common;
 
 use common::Rng;
+use common::volume::pyramid;
 use common::volume::tricubic;
 use subdyn::ffd::{Ffd, FfdParams};
-use subdyn::lattice::{Lattice, LatticeTopology, box_grid, cylinder};
+use subdyn::lattice::{Lattice, box_grid, cylinder};
 use subdyn::math::{Point3, bbox_diagonal, bounding_box};
 
 fn p(x: f64, y: f64, z: f64) -> Point3 {
@@ -19,24 +20,6 @@ fn params(levels: usize) -> FfdParams {
         levels,
         ..Default::default()
     }
-}
-
-fn pyramid() -> Lattice {
-    let pos = vec![
-        p(0.0, 0.0, 0.0),
-        p(1.0, 0.0, 0.0),
-        p(1.0, 1.0, 0.0),
-        p(0.0, 1.0, 0.0),
-        p(0.5, 0.5, 1.0),
-    ];
-    let cell = vec![
-        vec![0, 3, 2, 1],
-        vec![0, 1, 4],
-        vec![1, 2, 4],
-        vec![2, 3, 4],
-        vec![3, 0, 4],
-    ];
-    Lattice::new(pos, LatticeTopology::from_polyhedra(5, &[cell]).unwrap()).unwrap()
 }
 
 fn random_points(rng: &mut Rng, lat: &Lattice, n: usize) -> Vec<Point3> {

@@ -4,6 +4,7 @@
 mod common;
 
 use common::Rng;
+use common::volume::pyramid;
 use common::volume::{cubic_bspline, tricubic};
 use subdyn::lattice::{
     Lattice, LatticeBuilder, LatticeHierarchy, LatticeTopology, box_grid, cylinder, extrude,
@@ -18,26 +19,6 @@ fn p(x: f64, y: f64, z: f64) -> Point3 {
 
 fn unit_cube() -> Lattice {
     box_grid(p(0.0, 0.0, 0.0), p(1.0, 1.0, 1.0), [1, 1, 1]).unwrap()
-}
-
-/// A square pyramid: its apex has valence 4 in its cell.
-fn pyramid() -> Lattice {
-    let pos = vec![
-        p(0.0, 0.0, 0.0),
-        p(1.0, 0.0, 0.0),
-        p(1.0, 1.0, 0.0),
-        p(0.0, 1.0, 0.0),
-        p(0.5, 0.5, 1.0),
-    ];
-    let cell = vec![
-        vec![0, 3, 2, 1],
-        vec![0, 1, 4],
-        vec![1, 2, 4],
-        vec![2, 3, 4],
-        vec![3, 0, 4],
-    ];
-    let topo = LatticeTopology::from_polyhedra(5, &[cell]).unwrap();
-    Lattice::new(pos, topo).unwrap()
 }
 
 fn test_lattices() -> Vec<(&'static str, Lattice)> {

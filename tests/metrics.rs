@@ -7,8 +7,12 @@
 //! the plane when it falls inside the triangle, else the nearest of the three
 //! edge segments — so the leaf test is checked too, not only the traversal.
 
+mod common;
+
+use common::run_subdyn;
+
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
 use serde_json::Value;
 
@@ -567,14 +571,6 @@ fn limit_surface_samples_lie_on_the_limit_surface() {
 
 // ---------------------------------------------------------------- CLI
 
-fn subdyn(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_subdyn"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the subdyn binary runs")
-}
-
 fn ok(out: &Output) -> String {
     assert!(
         out.status.success(),
@@ -623,7 +619,7 @@ fn cli_compare_writes_a_report_with_chamfer_and_hausdorff_pct() {
     let dir = tempfile::tempdir().unwrap();
     write_obj(&dir.path().join("a.obj"), &grid(3, 0.25));
     write_obj(&dir.path().join("b.obj"), &grid(3, 0.0));
-    let out = ok(&subdyn(
+    let out = ok(&run_subdyn(
         dir.path(),
         &[
             "compare",
@@ -676,7 +672,7 @@ fn cli_compare_point_file_is_one_sided() {
     let dir = tempfile::tempdir().unwrap();
     write_obj(&dir.path().join("b.obj"), &grid(2, 0.0));
     std::fs::write(dir.path().join("p.xyz"), "0.5 0.5 0.5\n1 1 -0.25\n").unwrap();
-    let out = ok(&subdyn(
+    let out = ok(&run_subdyn(
         dir.path(),
         &["compare", "p.xyz", "b.obj", "--report", "r.json", "-q"],
     ));
@@ -698,24 +694,24 @@ fn cli_compare_bad_inputs_fail_cleanly() {
     std::fs::write(dir.path().join("p.xyz"), "0 0 0\n1 0 0\n0 1 0\n").unwrap();
     let inputs = ["a.obj", "p.xyz"];
     // B without faces.
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &["compare", "a.obj", "p.xyz", "--report", "r.json"],
     );
     assert_clean_failure(dir.path(), &out, "no faces", &inputs);
     // A missing file.
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &["compare", "missing.obj", "a.obj", "--report", "r.json"],
     );
     assert_clean_failure(dir.path(), &out, "missing.obj", &inputs);
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &["compare", "a.obj", "missing.obj", "--report", "r.json"],
     );
     assert_clean_failure(dir.path(), &out, "missing.obj", &inputs);
     // --limit-a on a point file.
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &[
             "compare",
@@ -729,7 +725,7 @@ fn cli_compare_bad_inputs_fail_cleanly() {
     assert_clean_failure(dir.path(), &out, "--limit-a", &inputs);
     // A NaN coordinate in A.
     std::fs::write(dir.path().join("nan.xyz"), "0 0 0\n1 nan 0\n").unwrap();
-    let out = subdyn(
+    let out = run_subdyn(
         dir.path(),
         &["compare", "nan.xyz", "a.obj", "--report", "r.json"],
     );
@@ -739,7 +735,7 @@ fn cli_compare_bad_inputs_fail_cleanly() {
 #[test]
 fn cli_bench_distance_prints_json_last_line() {
     let dir = tempfile::tempdir().unwrap();
-    let out = ok(&subdyn(
+    let out = ok(&run_subdyn(
         dir.path(),
         &[
             "bench",

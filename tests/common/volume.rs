@@ -2,6 +2,7 @@
 //! regular control grid, used to check Catmull-Clark volume refinement and
 //! FFD against the trivariate B-spline case (MacCracken & Joy 1996, §2.1).
 
+use subdyn::lattice::{Lattice, LatticeTopology};
 use subdyn::math::Point3;
 
 /// The centred uniform cubic B-spline `N(x)` (support `[-2, 2]`).
@@ -33,4 +34,24 @@ pub fn tricubic(points: &[Point3], n: [usize; 3], t: [f64; 3]) -> Point3 {
         }
     }
     out
+}
+
+/// A square pyramid lattice of one cell: its apex has valence 4 in the cell,
+/// so refinement makes type-4 cells there.
+pub fn pyramid() -> Lattice {
+    let pos = vec![
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(1.0, 0.0, 0.0),
+        Point3::new(1.0, 1.0, 0.0),
+        Point3::new(0.0, 1.0, 0.0),
+        Point3::new(0.5, 0.5, 1.0),
+    ];
+    let cell = vec![
+        vec![0, 3, 2, 1],
+        vec![0, 1, 4],
+        vec![1, 2, 4],
+        vec![2, 3, 4],
+        vec![3, 0, 4],
+    ];
+    Lattice::new(pos, LatticeTopology::from_polyhedra(5, &[cell]).unwrap()).unwrap()
 }
