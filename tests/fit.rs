@@ -97,6 +97,7 @@ fn energy_decreases_monotonically_without_robust_reweighting() {
         max_level: 1,
         max_steps: 12,
         energy_tolerance: 0.0,
+        error_tolerance: 0.0,
         ..Default::default()
     };
     let result = fit_point_cloud(&cloud, &cube_cage(), &params, &mut |_, _, _| {}).unwrap();

@@ -74,10 +74,24 @@ pub fn about_file(err: subdyn::Error, path: &Path) -> anyhow::Error {
     }
 }
 
-/// Fails early (before any work) when `path`'s extension names no mesh format.
+/// Fails early (before any work) when `path`'s extension names no mesh format
+/// or its directory does not exist.
 pub fn check_mesh_output(path: &Path) -> anyhow::Result<()> {
     MeshFormat::from_path(path)?;
-    Ok(())
+    check_output_dir(path)
+}
+
+/// Fails early (before any work) when the directory `path` would be written
+/// into does not exist, rather than after a long computation.
+pub fn check_output_dir(path: &Path) -> anyhow::Result<()> {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => anyhow::bail!(
+            "{}: the directory {} does not exist",
+            path.display(),
+            dir.display()
+        ),
+        _ => Ok(()),
+    }
 }
 
 /// Writes a JSON report atomically (pretty-printed, trailing newline).

@@ -14,7 +14,7 @@ use subdyn::mesh::{PointCloud, PolyMesh};
 use subdyn::subdivision::{RefineOptions, Refiner};
 
 use super::common::{
-    about_file, check_mesh_output, print_stdout, seconds, thousands, write_report,
+    about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, write_report,
 };
 use super::options::read_polygon_mesh;
 use super::progress::Progress;
@@ -87,6 +87,9 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     check_mesh_output(&args.output)?;
     if let Some(p) = &args.limit_out {
         check_mesh_output(p)?;
+    }
+    if let Some(p) = &args.report {
+        check_output_dir(p)?;
     }
     if let Some(p) = &args.plot {
         subdyn::render::check_png_path(p)?;

@@ -20,7 +20,7 @@ use subdyn::mesh::PolyMesh;
 use subdyn::subdivision::{RefineOptions, Refiner};
 
 use super::common::{
-    about_file, check_mesh_output, print_stdout, seconds, thousands, write_report,
+    about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, write_report,
 };
 use super::options::read_polygon_mesh;
 use super::progress::Progress;
@@ -127,6 +127,9 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     check_mesh_output(&args.output)?;
     if let Some(p) = &args.limit_out {
         check_mesh_output(p)?;
+    }
+    if let Some(p) = &args.report {
+        check_output_dir(p)?;
     }
     if args.tess == 0 || args.tess > 64 {
         anyhow::bail!("--tess {} is out of range: expected 1 to 64", args.tess);

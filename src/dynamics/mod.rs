@@ -3,10 +3,12 @@
 //! matrices assembled over the control points, and a preconditioned conjugate
 //! gradient solver.
 
+mod elements;
 mod matrices;
 mod pcg;
 mod quadrature;
 
+pub use elements::{parameter_area, patch_damping_matrix, patch_stiffness_matrix};
 pub use matrices::{MaterialParams, damping_matrix, mass_matrix, stiffness_matrix};
 pub use pcg::{PcgParams, PcgReport, pcg};
 pub use quadrature::{Quadrature, gauss_legendre, patch_samples, quadrature};

@@ -109,7 +109,7 @@ fn quadrature_on(table: &PatchTable, order: usize, per_piece: bool) -> Result<Qu
                             inv[1][0] * d[0] + inv[1][1] * d[1],
                         ];
                         let mut s = table.stencil(f, st);
-                        to_base_derivatives(&mut s, inv_axes);
+                        rows_to_base(&mut s.weights, inv_axes);
                         out.push((s, wa * wb * det_inv * det_axes));
                     }
                 }
@@ -153,17 +153,18 @@ fn quadrature_on(table: &PatchTable, order: usize, per_piece: bool) -> Result<Qu
     })
 }
 
-/// Maps derivative rows in `(s, t)` to `(u, v)` for `(s, t) = inv · ((u, v) − o)`.
-fn to_base_derivatives(s: &mut SampleStencil, inv: [[Real; 2]; 2]) {
-    for k in 0..s.cols.len() {
-        let d = crate::limit::chain_rule([1, 2, 3, 4, 5].map(|q| s.weights[q][k]), inv);
+/// Maps derivative rows in `(s, t)` to `(u, v)` for `(s, t) = inv · ((u, v) − o)`:
+/// `rows` are `[J, J_s, J_t, J_ss, J_st, J_tt]` over the same columns.
+pub(super) fn rows_to_base<W: AsMut<[Real]>>(rows: &mut [W; 6], inv: [[Real; 2]; 2]) {
+    for k in 0..rows[0].as_mut().len() {
+        let d = crate::limit::chain_rule([1, 2, 3, 4, 5].map(|q| rows[q].as_mut()[k]), inv);
         for (q, x) in d.into_iter().enumerate() {
-            s.weights[q + 1][k] = x;
+            rows[q + 1].as_mut()[k] = x;
         }
     }
 }
 
-fn invert(m: [[Real; 2]; 2]) -> [[Real; 2]; 2] {
+pub(super) fn invert(m: [[Real; 2]; 2]) -> [[Real; 2]; 2] {
     let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
     [
         [m[1][1] / det, -m[0][1] / det],

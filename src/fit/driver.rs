@@ -17,7 +17,7 @@
 use std::time::Instant;
 
 use crate::dynamics::{
-    MaterialParams, PcgParams, damping_matrix, pcg, quadrature, stiffness_matrix,
+    MaterialParams, PcgParams, parameter_area, patch_damping_matrix, patch_stiffness_matrix, pcg,
 };
 use crate::error::{Error, Result};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
@@ -81,15 +81,14 @@ pub fn fit_point_cloud(
                 ..Default::default()
             },
         )?;
-        // Quadrature on level-1 pieces: exact on regular faces (one bicubic
-        // each) and cheaper than the closest-point patches.
+        // The thin plate and the damping, patch by patch on the level-1
+        // pieces: exact on regular faces (one bicubic each).
         let qtable = PatchTable::new(&refiner, &mesh.positions, 1)?;
-        let q = quadrature(&qtable, params.quadrature_order)?;
         let s = qtable.to_level();
-        let area: Real = q.weights.iter().sum();
+        let area = parameter_area(&qtable);
         let material = MaterialParams::thin_plate(params.tension, params.bending, area);
-        let k = stiffness_matrix(&q, s, &material)?;
-        let d = damping_matrix(&q, s, None, params.damping / area)?;
+        let k = patch_stiffness_matrix(&qtable, params.quadrature_order, &material)?;
+        let d = patch_damping_matrix(&qtable, params.quadrature_order, params.damping / area)?;
         let kd = k.linear_combination(1.0, &d, 1.0)?;
         // Surface samples (the centre of every level-1 piece) for the
         // surface-to-data springs.
@@ -111,7 +110,13 @@ pub fn fit_point_cloud(
         let mut steps = 0;
         let mut hints: Option<Vec<(u32, [Real; 2])>> = None;
         loop {
+            // Newton from the previous answers every step; every
+            // `reseed_every` steps also from the nearest seed, to catch jumps
+            // to another part of the surface.
             let closest = match &hints {
+                Some(h) if steps % params.reseed_every != 0 => {
+                    engine.closest_points_local(points, h)?
+                }
                 Some(h) => engine.closest_points_near(points, h)?,
                 None => engine.closest_points(points)?,
             };
@@ -148,11 +153,13 @@ pub fn fit_point_cloud(
                         .map(|(a, b)| a.coords.dot(&b.coords))
                         .sum::<Real>();
             progress(level, steps, e);
+            let stats = ErrorStats::new(&dist, diameter);
             let settled = energy.last().is_some_and(|&prev: &Real| {
                 (prev - e).abs() <= params.energy_tolerance * prev.abs()
-            });
+            }) || step_rms_pct
+                .last()
+                .is_some_and(|&prev: &Real| prev - stats.rms_pct <= params.error_tolerance * prev);
             energy.push(e);
-            let stats = ErrorStats::new(&dist, diameter);
             step_elapsed.push(start.elapsed().as_secs_f64());
             step_rms_pct.push(stats.rms_pct);
             step_p95_pct.push(stats.p95_pct);

@@ -32,8 +32,16 @@ pub struct FitParams {
     /// Implicit steps per level at most (default 20).
     pub max_steps: usize,
     /// A level has settled when the energy changes by less than this fraction
-    /// between steps (default 1e-3).
+    /// between steps (default 1e-3) …
     pub energy_tolerance: Real,
+    /// … or when a step lowers the RMS data-to-surface distance by less than
+    /// this fraction (default 0.01; 0 turns this test off).
+    pub error_tolerance: Real,
+    /// Closest points are found by Newton descent from the previous step's
+    /// answers; every `reseed_every` steps (default 4) also from the nearest
+    /// seed sample, which catches a point whose closest surface part has
+    /// changed but needs the seeds' k-d tree rebuilt.
+    pub reseed_every: usize,
     /// Stop subdividing when a level lowers the RMS error by less than this
     /// fraction (default 0.1): finer levels would fit the noise.
     pub min_level_gain: Real,
@@ -70,6 +78,8 @@ impl Default for FitParams {
             max_level: 3,
             max_steps: 20,
             energy_tolerance: 1e-3,
+            error_tolerance: 0.01,
+            reseed_every: 4,
             min_level_gain: 0.1,
             max_control_fraction: 0.5,
             tension: 1e-5,
@@ -111,6 +121,7 @@ impl FitParams {
         }
         for (name, v) in [
             ("energy_tolerance", self.energy_tolerance),
+            ("error_tolerance", self.error_tolerance),
             ("min_level_gain", self.min_level_gain),
             ("max_control_fraction", self.max_control_fraction),
             ("tension", self.tension),
@@ -121,6 +132,9 @@ impl FitParams {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(name, v, "must be finite and ≥ 0");
             }
+        }
+        if self.reseed_every == 0 {
+            return bad("reseed_every", 0.0, "expected at least 1");
         }
         if !(1..=4).contains(&self.patch_level) {
             return bad("patch_level", self.patch_level as Real, "expected 1 to 4");

@@ -8,8 +8,14 @@
 //! where the Hessian is indefinite and a backtracking line search; when the
 //! iterate leaves its face it crosses the edge into the neighbouring face.
 //! The result is reported as a base-face sample `(face, u, v)`.
+//!
+//! While the surface moves (fitting), [`ClosestPointEngine::set_positions`]
+//! only moves the patches; the seed tree is rebuilt when a query next needs
+//! it, so descents started from the previous answers alone
+//! ([`ClosestPointEngine::closest_points_local`]) skip that cost.
 
 use std::num::NonZero;
+use std::sync::OnceLock;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
@@ -67,7 +73,8 @@ pub struct ClosestPoint {
 pub struct ClosestPointEngine {
     table: PatchTable,
     seeds: Vec<(u32, [Real; 2])>,
-    tree: ImmutableKdTree<Real, 3>,
+    /// The k-d tree of the seeds' current positions, built when first needed.
+    tree: OnceLock<ImmutableKdTree<Real, 3>>,
     params: ClosestPointParams,
     scale: Real,
 }
@@ -111,26 +118,34 @@ impl ClosestPointEngine {
                 })
             })
             .collect();
-        let mut engine = ClosestPointEngine {
+        let scale = bbox_diagonal(table.positions()).max(Real::MIN_POSITIVE);
+        let engine = ClosestPointEngine {
             table,
             seeds,
-            tree: ImmutableKdTree::new_from_slice(&[[0.0; 3]]),
+            tree: OnceLock::new(),
             params: params.clone(),
-            scale: 0.0,
+            scale,
         };
-        engine.rebuild_tree()?;
+        engine.seed_tree()?;
         Ok(engine)
     }
 
     /// Moves the control points (same topology), keeping everything that
-    /// depends on topology alone; cheaper than [`new`](Self::new).
+    /// depends on topology alone; cheaper than [`new`](Self::new). The seed
+    /// tree is rebuilt by the next query that needs it.
     pub fn set_positions(&mut self, positions: &[Point3]) -> Result<()> {
         self.table.set_positions(positions)?;
-        self.rebuild_tree()
+        self.tree = OnceLock::new();
+        self.scale = bbox_diagonal(self.table.positions()).max(Real::MIN_POSITIVE);
+        Ok(())
     }
 
-    /// Re-evaluates the seeds and rebuilds their k-d tree.
-    fn rebuild_tree(&mut self) -> Result<()> {
+    /// The k-d tree of the seeds at the current positions (built once per
+    /// [`set_positions`](Self::set_positions)).
+    fn seed_tree(&self) -> Result<&ImmutableKdTree<Real, 3>> {
+        if let Some(tree) = self.tree.get() {
+            return Ok(tree);
+        }
         let pts: Vec<[Real; 3]> = self
             .seeds
             .par_iter()
@@ -140,9 +155,9 @@ impl ClosestPointEngine {
                     .map(|e| [e.p.x, e.p.y, e.p.z])
             })
             .collect::<Result<_>>()?;
-        self.tree = ImmutableKdTree::new_from_slice(&pts);
-        self.scale = bbox_diagonal(self.table.positions()).max(Real::MIN_POSITIVE);
-        Ok(())
+        Ok(self
+            .tree
+            .get_or_init(|| ImmutableKdTree::new_from_slice(&pts)))
     }
 
     /// The closest limit-surface point to `q`.
@@ -158,23 +173,35 @@ impl ClosestPointEngine {
         q: Point3,
         hint: Option<(u32, [Real; 2])>,
     ) -> Result<ClosestPoint> {
-        if !q.coords.iter().all(|c| c.is_finite()) {
-            return Err(Error::Input(format!(
-                "query point ({}, {}, {}) is not finite",
-                q.x, q.y, q.z
-            )));
-        }
+        check_query(q)?;
         let candidates = if hint.is_some() {
             1
         } else {
             self.params.candidates
         };
         let k = NonZero::new(candidates.min(self.seeds.len())).unwrap_or(NonZero::<usize>::MIN);
-        let near = self.tree.nearest_n::<SquaredEuclidean>(&[q.x, q.y, q.z], k);
-        let starts = near
-            .iter()
-            .map(|nn| self.seeds[nn.item as usize])
-            .chain(hint.filter(|h| (h.0 as usize) < self.table.num_patches()));
+        let near = self
+            .seed_tree()?
+            .nearest_n::<SquaredEuclidean>(&[q.x, q.y, q.z], k);
+        let starts = near.iter().map(|nn| self.seeds[nn.item as usize]);
+        self.best_descent(q, starts.chain(hint))
+    }
+
+    /// The closest point to `q` reached by descending from `start` alone (a
+    /// previous answer): a local minimum of the distance, the closest point
+    /// when the surface has moved little since `start` was found.
+    pub fn closest_point_local(&self, q: Point3, start: (u32, [Real; 2])) -> Result<ClosestPoint> {
+        check_query(q)?;
+        self.best_descent(q, std::iter::once(start))
+    }
+
+    /// The nearest of the descents from `starts` (out-of-range patches skipped).
+    fn best_descent(
+        &self,
+        q: Point3,
+        starts: impl Iterator<Item = (u32, [Real; 2])>,
+    ) -> Result<ClosestPoint> {
+        let starts = starts.filter(|h| (h.0 as usize) < self.table.num_patches());
         let mut best: Option<(Real, usize, [Real; 2], PatchPoint)> = None;
         for (f, st) in starts {
             let (f, st, e) = self.descend(q, f as usize, st)?;
@@ -216,6 +243,7 @@ impl ClosestPointEngine {
                 queries.len()
             )));
         }
+        self.seed_tree()?;
         queries
             .par_iter()
             .zip(hints)
@@ -223,8 +251,30 @@ impl ClosestPointEngine {
             .collect()
     }
 
+    /// [`closest_point_local`](Self::closest_point_local) for many queries,
+    /// in parallel: no seed search, so no seed tree either.
+    pub fn closest_points_local(
+        &self,
+        queries: &[Point3],
+        starts: &[(u32, [Real; 2])],
+    ) -> Result<Vec<ClosestPoint>> {
+        if starts.len() != queries.len() {
+            return Err(Error::Input(format!(
+                "{} starts for {} queries",
+                starts.len(),
+                queries.len()
+            )));
+        }
+        queries
+            .par_iter()
+            .zip(starts)
+            .map(|(&q, &s)| self.closest_point_local(q, s))
+            .collect()
+    }
+
     /// Closest points of many queries, in parallel.
     pub fn closest_points(&self, queries: &[Point3]) -> Result<Vec<ClosestPoint>> {
+        self.seed_tree()?;
         queries.par_iter().map(|&q| self.closest_point(q)).collect()
     }
 
@@ -371,6 +421,17 @@ impl ClosestPointEngine {
     /// Bounding-box diagonal of the control points (the scale of distances).
     pub fn scale(&self) -> Real {
         self.scale
+    }
+}
+
+fn check_query(q: Point3) -> Result<()> {
+    if q.coords.iter().all(|c| c.is_finite()) {
+        Ok(())
+    } else {
+        Err(Error::Input(format!(
+            "query point ({}, {}, {}) is not finite",
+            q.x, q.y, q.z
+        )))
     }
 }
 

@@ -331,6 +331,17 @@ impl PatchTable {
         &self.to_level
     }
 
+    /// The 16 bicubic B-spline control points of patch `f` as rows over the
+    /// level-`L` vertices (phantom points at boundaries and creases are
+    /// combinations), row `k` for weight `k` of
+    /// [`patch_weights`](super::patch_weights); `None` for a patch at an
+    /// irregular vertex.
+    pub fn grid_rows(&self, f: usize) -> Option<[(&[u32], &[Real]); 16]> {
+        self.patches[f]
+            .regular
+            .then(|| std::array::from_fn(|k| self.grid_table.row(16 * f + k)))
+    }
+
     /// The affine map of patch `f`'s `(s, t)` into its base face's `(u, v)`:
     /// `(u, v) = origin + axes · (s, t)`.
     pub fn patch_frame(&self, f: usize) -> ([Real; 2], [[Real; 2]; 2]) {

@@ -357,7 +357,7 @@ impl StencilTable {
         Self::from_chunks(num_cols, num_rows, chunks)
     }
 
-    fn from_chunks(
+    pub(super) fn from_chunks(
         num_cols: usize,
         num_rows: usize,
         chunks: Vec<(Vec<usize>, Vec<u32>, Vec<Real>)>,

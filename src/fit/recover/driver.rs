@@ -18,7 +18,7 @@ use rayon::prelude::*;
 
 use super::{RecoverLevel, RecoverParams, RecoverReport};
 use crate::dynamics::{
-    MaterialParams, PcgParams, damping_matrix, patch_samples, pcg, stiffness_matrix,
+    MaterialParams, PcgParams, patch_damping_matrix, patch_samples, patch_stiffness_matrix, pcg,
 };
 use crate::error::{Error, Result};
 use crate::fit::ErrorStats;
@@ -157,12 +157,12 @@ pub fn recover_shape(
         let jv = q.rows.dv.compose(s)?;
         let area: Real = q.weights.iter().sum();
         let material = MaterialParams::thin_plate(params.tension, params.bending, area);
-        let k = stiffness_matrix(&q, s, &material)?;
+        let k = patch_stiffness_matrix(&qtable, params.quadrature_order, &material)?;
         // Damping on the limit surface is blind to control-point modes that
         // barely move it (a checkerboard over a coarse cage); a small
         // proximal term on the control points themselves, 1 % of D's mean
         // diagonal, keeps the solves from letting them drift.
-        let d = damping_matrix(&q, s, None, params.damping / area)?;
+        let d = patch_damping_matrix(&qtable, params.quadrature_order, params.damping / area)?;
         let diag = d.diagonal();
         let delta = 0.01 * diag.iter().sum::<Real>() / diag.len().max(1) as Real;
         let d = d.linear_combination(1.0, &StencilTable::identity(diag.len()), delta)?;

@@ -1,0 +1,221 @@
+//! `M`, `D` and `K` assembled patch by patch from dense element matrices.
+//!
+//! Same integrals as [`super::mass_matrix`] and [`super::stiffness_matrix`]
+//! (Qin, Mandal, Vemuri 1998, eqs. 10–12, in the parameter measure
+//! `dA = du dv`), organised as the finite-element method does: every
+//! level-`L` patch gets its own small dense matrix `K_e = ∫∫ Σ_q c_q J_qᵀ J_q`
+//! over the level-`L` vertices it depends on, the patches are scattered into
+//! `K_L`, and `K = Sᵀ K_L S` carries that to the control points.
+//!
+//! A regular patch is a bicubic B-spline over 16 grid points, and in the
+//! parameter measure its matrix over those points depends only on the
+//! patch's frame in its base face — one `16 × 16` matrix per frame, exact
+//! with a 4 × 4 Gauss-Legendre rule, shared by all the patches with that
+//! frame (every level-1 patch of a quad mesh has one of eight). Patches at
+//! irregular vertices use the same rule on the patch as a whole through the
+//! exact local stencils ([`super::patch_samples`]'s points), which is not
+//! exact there but is what the point-cloud fit and the volume recovery
+//! sample their forces with. On a regular mesh the result equals
+//! [`super::stiffness_matrix`] of [`super::quadrature`] to round-off
+//! (`tests/dynamics.rs`).
+
+use rayon::prelude::*;
+
+use super::gauss_legendre;
+use super::quadrature::{invert, rows_to_base};
+use crate::error::{Error, Result};
+use crate::limit::{PatchTable, SampleStencil, patch_weights};
+use crate::math::Real;
+use crate::stencil::{Elements, StencilTable};
+
+use super::MaterialParams;
+
+/// `K` (thin plate under tension) over the control points of `table`'s
+/// base mesh, patch by patch with an `order × order` rule (module docs).
+pub fn patch_stiffness_matrix(
+    table: &PatchTable,
+    order: usize,
+    params: &MaterialParams,
+) -> Result<StencilTable> {
+    params.check()?;
+    let c = [
+        0.0,
+        params.alpha11,
+        params.alpha22,
+        params.beta11,
+        params.beta12,
+        params.beta22,
+    ];
+    assembled(table, order, c)
+}
+
+/// `D = ∫∫ γ JᵀJ du dv` (or `M` with `γ = μ`) over the control points,
+/// patch by patch (module docs).
+pub fn patch_damping_matrix(table: &PatchTable, order: usize, gamma: Real) -> Result<StencilTable> {
+    MaterialParams {
+        gamma,
+        ..Default::default()
+    }
+    .check()?;
+    assembled(table, order, [gamma, 0.0, 0.0, 0.0, 0.0, 0.0])
+}
+
+/// The area of the parameter domain (`∫∫ du dv` over the base faces, quad
+/// sub-face tiles for n-gons): the weights of any quadrature sum to it.
+pub fn parameter_area(table: &PatchTable) -> Real {
+    (0..table.num_patches())
+        .map(|f| inverse(table.patch_frame(f).1).1.recip())
+        .sum()
+}
+
+/// `Sᵀ (Σ_e K_e) S` for the weights `c` of `[J, J_u, J_v, J_uu, J_uv, J_vv]`.
+fn assembled(table: &PatchTable, order: usize, c: [Real; 6]) -> Result<StencilTable> {
+    if order == 0 || order > 16 {
+        return Err(Error::Input(format!(
+            "quadrature order {order} must be between 1 and 16"
+        )));
+    }
+    let gl = gauss_legendre(order);
+    let per_patch: Vec<(Vec<u32>, Vec<Real>)> = (0..table.num_patches())
+        .into_par_iter()
+        .map_init(Vec::new, |frames, f| {
+            patch_element(table, f, &gl, c, frames)
+        })
+        .collect();
+    let mut elements = Elements::new();
+    for (cols, matrix) in &per_patch {
+        elements.push(cols, matrix)?;
+    }
+    let s = table.to_level();
+    StencilTable::from_elements(s.num_rows(), &elements)?.pulled_back(s)
+}
+
+/// Inverse of a 2 × 2 matrix and its |determinant|.
+fn inverse(m: [[Real; 2]; 2]) -> ([[Real; 2]; 2], Real) {
+    (invert(m), (m[0][0] * m[1][1] - m[0][1] * m[1][0]).abs())
+}
+
+/// Adds `w · Σ_q c_q j_q j_qᵀ` to the dense `m × m` matrix `out`, the rows
+/// `j_q` given by `row(q)`.
+fn add_outer<'a>(
+    out: &mut [Real],
+    m: usize,
+    c: [Real; 6],
+    w: Real,
+    row: impl Fn(usize) -> &'a [Real],
+) {
+    for (q, &cq) in c.iter().enumerate() {
+        if cq == 0.0 {
+            continue;
+        }
+        let j = row(q);
+        for a in 0..m {
+            let ja = cq * w * j[a];
+            if ja != 0.0 {
+                for (o, &jb) in out[a * m..(a + 1) * m].iter_mut().zip(j) {
+                    *o += ja * jb;
+                }
+            }
+        }
+    }
+}
+
+/// The element of patch `f` over the level-`L` vertices (columns and
+/// row-major matrix). `frames` caches
+/// the grid matrices of the frames seen so far (per thread).
+fn patch_element(
+    table: &PatchTable,
+    f: usize,
+    gl: &[(Real, Real)],
+    c: [Real; 6],
+    frames: &mut Vec<([[Real; 2]; 2], Vec<Real>)>,
+) -> (Vec<u32>, Vec<Real>) {
+    let (_, axes) = table.patch_frame(f);
+    let (inv, det) = inverse(axes);
+    let Some(grid) = table.grid_rows(f) else {
+        // Irregular: exact stencils at the Gauss points of the whole patch.
+        let mut cols: Vec<u32> = Vec::new();
+        let samples: Vec<(SampleStencil, Real)> = gl
+            .iter()
+            .flat_map(|&(a, wa)| gl.iter().map(move |&(b, wb)| ([a, b], wa * wb)))
+            .map(|(st, w)| {
+                let mut s = table.stencil(f, st);
+                rows_to_base(&mut s.weights, inv);
+                cols.extend_from_slice(&s.cols);
+                (s, w * det)
+            })
+            .collect();
+        cols.sort_unstable();
+        cols.dedup();
+        let m = cols.len();
+        let mut matrix = vec![0.0; m * m];
+        let mut dense = [(); 6].map(|_| vec![0.0; m]);
+        for (s, w) in &samples {
+            for (q, d) in dense.iter_mut().enumerate() {
+                d.iter_mut().for_each(|x| *x = 0.0);
+                for (&col, &x) in s.cols.iter().zip(&s.weights[q]) {
+                    d[cols.binary_search(&col).unwrap_or(0)] += x;
+                }
+            }
+            add_outer(&mut matrix, m, c, *w, |q| &dense[q]);
+        }
+        return (cols, matrix);
+    };
+    // Regular: the frame's 16 × 16 grid matrix, carried by the grid rows G
+    // (a selection for interior patches) as Gᵀ E G.
+    let e = match frames.iter().position(|(a, _)| *a == axes) {
+        Some(i) => &frames[i].1,
+        None => {
+            let mut e = vec![0.0; 256];
+            for &(a, wa) in gl {
+                for &(b, wb) in gl {
+                    let mut rows = patch_weights(a, b);
+                    rows_to_base(&mut rows, inv);
+                    add_outer(&mut e, 16, c, wa * wb * det, |q| &rows[q]);
+                }
+            }
+            frames.push((axes, e));
+            &frames.last().expect("just pushed").1
+        }
+    };
+    let mut cols: Vec<u32> = grid.iter().flat_map(|(c, _)| c.iter().copied()).collect();
+    cols.sort_unstable();
+    cols.dedup();
+    let m = cols.len();
+    let mut g = vec![0.0; 16 * m];
+    for (k, (gc, gw)) in grid.iter().enumerate() {
+        for (&col, &x) in gc.iter().zip(gw.iter()) {
+            g[k * m + cols.binary_search(&col).unwrap_or(0)] += x;
+        }
+    }
+    // E G (16 × m), then Gᵀ (E G).
+    let mut eg = vec![0.0; 16 * m];
+    for a in 0..16 {
+        for k in 0..16 {
+            let x = e[a * 16 + k];
+            if x != 0.0 {
+                for (o, &y) in eg[a * m..(a + 1) * m]
+                    .iter_mut()
+                    .zip(&g[k * m..(k + 1) * m])
+                {
+                    *o += x * y;
+                }
+            }
+        }
+    }
+    let mut matrix = vec![0.0; m * m];
+    for k in 0..16 {
+        for i in 0..m {
+            let x = g[k * m + i];
+            if x != 0.0 {
+                for (o, &y) in matrix[i * m..(i + 1) * m]
+                    .iter_mut()
+                    .zip(&eg[k * m..(k + 1) * m])
+                {
+                    *o += x * y;
+                }
+            }
+        }
+    }
+    (cols, matrix)
+}
