@@ -23,7 +23,7 @@ use crate::error::{Error, Result};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 use crate::forces::{RobustKernel, robust_weights, row_springs, spring_system};
-use crate::limit::{ClosestPointEngine, ClosestPointParams, PatchTable};
+use crate::limit::{ClosestPointEngine, ClosestPointParams};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
 use crate::subdivision::{RefineOptions, Refiner};
@@ -81,25 +81,29 @@ pub fn fit_point_cloud(
                 ..Default::default()
             },
         )?;
-        // The thin plate and the damping, patch by patch on the level-1
+        // The thin plate and the damping, patch by patch on the engine's
         // pieces: exact on regular faces (one bicubic each).
-        let qtable = PatchTable::new(&refiner, &mesh.positions, 1)?;
+        let qtable = engine.table();
         let s = qtable.to_level();
         let area = parameter_area(&qtable);
         let material = MaterialParams::thin_plate(params.tension, params.bending, area);
-        let k = patch_stiffness_matrix(&qtable, params.quadrature_order, &material)?;
-        let d = patch_damping_matrix(&qtable, params.quadrature_order, params.damping / area)?;
+        let k = patch_stiffness_matrix(qtable, params.quadrature_order, &material)?;
+        let d = patch_damping_matrix(qtable, params.quadrature_order, params.damping / area)?;
         let kd = k.linear_combination(1.0, &d, 1.0)?;
-        // Surface samples (the centre of every level-1 piece) for the
+        // Surface samples (cell centres of every patch) for the
         // surface-to-data springs.
+        let per_side = params.surface_samples;
         let mut centres = crate::stencil::StencilTable::with_capacity(
             qtable.to_level().num_rows(),
-            qtable.num_patches(),
+            per_side * per_side * qtable.num_patches(),
             0,
         );
         for f in 0..qtable.num_patches() {
-            let (cols, w) = qtable.position_stencil(f, [0.5, 0.5]);
-            centres.push_row(cols.into_iter().zip(w));
+            for i in 0..per_side * per_side {
+                let st = [i % per_side, i / per_side].map(|k| (k as Real + 0.5) / per_side as Real);
+                let (cols, w) = qtable.position_stencil(f, st);
+                centres.push_row(cols.into_iter().zip(w));
+            }
         }
         let centres = centres.compose(s)?;
         let mut p = mesh.positions.clone();
@@ -174,7 +178,15 @@ pub fn fit_point_cloud(
                 .zip(&dp)
                 .map(|(a, b)| Point3::from(a.coords + b.coords))
                 .collect();
-            let report = pcg(&a, &rhs, &mut p, &PcgParams::default())?;
+            let report = pcg(
+                &a,
+                &rhs,
+                &mut p,
+                &PcgParams {
+                    tolerance: params.cg_tolerance,
+                    ..Default::default()
+                },
+            )?;
             cg_iterations += report.iterations;
             engine.set_positions(&p)?;
             steps += 1;

@@ -62,9 +62,17 @@ pub struct FitParams {
     /// its nearest data point, Huber-weighted) relative to the data-to-surface
     /// springs (default 0.5; 0 turns them off).
     pub surface_weight: Real,
+    /// Relative residual at which the conjugate-gradient solve of each
+    /// implicit step stops (default 1e-5): the step is re-linearised at once,
+    /// so solving it further buys nothing.
+    pub cg_tolerance: Real,
+    /// Surface samples per side of every closest-point patch for the
+    /// surface-to-data springs (default 2: 2 × 2 cell centres per patch).
+    pub surface_samples: usize,
     /// Robust kernel of the data springs (default Tukey, 4.685 σ̂).
     pub robust: RobustKernel,
-    /// Uniform level of the closest-point patches (default 2).
+    /// Uniform level of the closest-point patches, which also carry the
+    /// thin plate and the surface samples (default 1).
     pub patch_level: usize,
     /// Gauss-Legendre points per side of every polynomial piece (default 4).
     pub quadrature_order: usize,
@@ -86,8 +94,10 @@ impl Default for FitParams {
             bending: 1e-4,
             damping: 0.05,
             surface_weight: 0.5,
+            cg_tolerance: 1e-5,
+            surface_samples: 2,
             robust: RobustKernel::default(),
-            patch_level: 2,
+            patch_level: 1,
             quadrature_order: 4,
         }
     }
@@ -132,6 +142,20 @@ impl FitParams {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(name, v, "must be finite and ≥ 0");
             }
+        }
+        if !(self.cg_tolerance > 0.0 && self.cg_tolerance < 1.0) {
+            return bad(
+                "cg_tolerance",
+                self.cg_tolerance,
+                "expected 0 < tolerance < 1",
+            );
+        }
+        if !(1..=8).contains(&self.surface_samples) {
+            return bad(
+                "surface_samples",
+                self.surface_samples as Real,
+                "expected 1 to 8",
+            );
         }
         if self.reseed_every == 0 {
             return bad("reseed_every", 0.0, "expected at least 1");

@@ -456,16 +456,33 @@ impl StencilTable {
                 self.num_cols
             )));
         }
-        let mut out = StencilTable::with_capacity(self.num_cols, self.num_rows(), 0);
+        let mut out = StencilTable::with_capacity(
+            self.num_cols,
+            self.num_rows(),
+            self.num_entries().max(other.num_entries()),
+        );
+        // Where each column sits in the row being built (usize::MAX: not
+        // yet), so that merging costs O(1) per entry.
+        let mut slot = vec![usize::MAX; self.num_cols];
         for r in 0..self.num_rows() {
             let (c1, w1) = self.row(r);
             let (c2, w2) = other.row(r);
-            out.push_row(
-                c1.iter()
-                    .zip(w1)
-                    .map(|(&c, &w)| (c, a * w))
-                    .chain(c2.iter().zip(w2).map(|(&c, &w)| (c, b * w))),
-            );
+            let terms = c1.iter().zip(w1).map(|(&c, &w)| (c, a * w));
+            for (c, w) in terms.chain(c2.iter().zip(w2).map(|(&c, &w)| (c, b * w))) {
+                match slot[c as usize] {
+                    usize::MAX => {
+                        slot[c as usize] = out.indices.len();
+                        out.indices.push(c);
+                        out.weights.push(w);
+                    }
+                    k => out.weights[k] += w,
+                }
+            }
+            let start = *out.offsets.last().unwrap_or(&0);
+            for &c in &out.indices[start..] {
+                slot[c as usize] = usize::MAX;
+            }
+            out.offsets.push(out.indices.len());
         }
         Ok(out)
     }
