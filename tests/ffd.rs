@@ -425,3 +425,54 @@ f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\nf 9 1 2\n";
         );
     }
 }
+
+#[test]
+fn bench_ffd_local_updates_match_the_full_product() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = common::run_subdyn(
+        dir.path(),
+        &[
+            "bench",
+            "ffd",
+            "--vertices",
+            "3000",
+            "--octree-levels",
+            "1",
+            "--levels",
+            "2",
+            "--updates",
+            "20",
+            "--quiet",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let last = text.lines().last().expect("some output");
+    let json: serde_json::Value = serde_json::from_str(last).expect("the last line is JSON");
+    // A torus inside its own bounding box: every vertex is embedded.
+    assert_eq!(json["embedded"], json["vertices"], "{last}");
+    assert_eq!(json["outside"], 0, "{last}");
+    assert!(
+        json["max_abs_diff_local_vs_full"].as_f64().unwrap() < 1e-12,
+        "{last}"
+    );
+    // The 32³-cell refined lattice: 4³ cells refined three times.
+    assert_eq!(json["refined_32_cells"], 32768, "{last}");
+    let bytes = json["refined_32_topology_bytes"].as_u64().unwrap();
+    assert!(
+        bytes > json["refined_32_type_n_bytes"].as_u64().unwrap(),
+        "{last}"
+    );
+    for key in ["refine_s", "embed_s", "local_update_ms", "full_product_ms"] {
+        assert!(
+            json[key].as_f64().is_some_and(|s| s > 0.0),
+            "{key} in {last}"
+        );
+    }
+    let bad = common::run_subdyn(dir.path(), &["bench", "ffd", "--levels", "9"]);
+    assert_eq!(bad.status.code(), Some(1));
+}

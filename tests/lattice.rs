@@ -430,3 +430,102 @@ fn lattice_cli_writes_a_readable_lattice_and_refuses_bad_input() {
         assert!(!d.join("x.json").exists());
     }
 }
+
+/// Every derived incidence of `LatticeTopology::new` recounted by brute
+/// force from the face loops and cell face lists alone.
+fn assert_incidences_match_a_recount(name: &str, t: &LatticeTopology) {
+    use std::collections::BTreeSet;
+    let mut edges: Vec<[u32; 2]> = Vec::new();
+    for f in 0..t.num_faces() {
+        let l = t.faces.row(f);
+        for i in 0..l.len() {
+            let (a, b) = (l[i], l[(i + 1) % l.len()]);
+            let e = [a.min(b), a.max(b)];
+            if !edges.contains(&e) {
+                edges.push(e);
+            }
+            assert_eq!(
+                t.edges[t.face_edges.row(f)[i] as usize],
+                e,
+                "{name}: face {f} edge {i}"
+            );
+        }
+    }
+    assert_eq!(t.edges, edges, "{name}: edges in first-appearance order");
+    for (e, &[a, b]) in edges.iter().enumerate() {
+        let faces: Vec<u32> = (0..t.num_faces() as u32)
+            .filter(|&f| {
+                let l = t.faces.row(f as usize);
+                (0..l.len()).any(|i| {
+                    let (x, y) = (l[i], l[(i + 1) % l.len()]);
+                    (x, y) == (a, b) || (x, y) == (b, a)
+                })
+            })
+            .collect();
+        assert_eq!(
+            t.edge_faces.row(e),
+            faces.as_slice(),
+            "{name}: edge {e} faces"
+        );
+        let cells: BTreeSet<u32> = (0..t.num_cells() as u32)
+            .filter(|&c| t.cells.row(c as usize).iter().any(|f| faces.contains(f)))
+            .collect();
+        let got: BTreeSet<u32> = t.edge_cells.row(e).iter().copied().collect();
+        assert_eq!(got, cells, "{name}: edge {e} cells");
+        assert_eq!(
+            t.edge_cells.row(e).len(),
+            cells.len(),
+            "{name}: edge {e} cells repeated"
+        );
+    }
+    for c in 0..t.num_cells() {
+        let verts: BTreeSet<u32> = t
+            .cells
+            .row(c)
+            .iter()
+            .flat_map(|&f| t.faces.row(f as usize).to_vec())
+            .collect();
+        let want: Vec<u32> = verts.into_iter().collect();
+        assert_eq!(
+            t.cell_vertices.row(c),
+            want.as_slice(),
+            "{name}: cell {c} vertices"
+        );
+    }
+    for v in 0..t.num_vertices {
+        let v32 = v as u32;
+        let cells: Vec<u32> = (0..t.num_cells() as u32)
+            .filter(|&c| t.cell_vertices.row(c as usize).contains(&v32))
+            .collect();
+        assert_eq!(
+            t.vertex_cells.row(v),
+            cells.as_slice(),
+            "{name}: vertex {v} cells"
+        );
+        let faces: Vec<u32> = (0..t.num_faces() as u32)
+            .filter(|&f| t.faces.row(f as usize).contains(&v32))
+            .collect();
+        assert_eq!(
+            t.vertex_faces.row(v),
+            faces.as_slice(),
+            "{name}: vertex {v} faces"
+        );
+        let es: Vec<u32> = (0..edges.len() as u32)
+            .filter(|&e| edges[e as usize].contains(&v32))
+            .collect();
+        assert_eq!(
+            t.vertex_edges.row(v),
+            es.as_slice(),
+            "{name}: vertex {v} edges"
+        );
+    }
+}
+
+#[test]
+fn derived_incidences_match_a_brute_force_recount() {
+    for (name, lat) in test_lattices() {
+        assert_incidences_match_a_recount(name, &lat.topology);
+        let h = LatticeHierarchy::new(&lat, 1).unwrap();
+        assert_incidences_match_a_recount(name, &h.level(1).topology);
+    }
+}

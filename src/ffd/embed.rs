@@ -67,6 +67,9 @@ pub fn embedding(
         .map(|p| {
             let mut best: Option<(u32, CellCoords)> = None;
             for &c in index.candidates(p) {
+                if !index.box_contains(c, p) {
+                    continue;
+                }
                 let Some(cc) = cell_coords(cells, c as usize, x, p) else {
                     continue;
                 };
