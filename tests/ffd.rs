@@ -8,7 +8,7 @@ use common::Rng;
 use common::volume::pyramid;
 use common::volume::tricubic;
 use subdyn::ffd::{Ffd, FfdParams};
-use subdyn::lattice::{Lattice, box_grid, cylinder};
+use subdyn::lattice::{Lattice, box_grid, cylinder, locally_refined};
 use subdyn::math::{Point3, bbox_diagonal, bounding_box};
 
 fn p(x: f64, y: f64, z: f64) -> Point3 {
@@ -41,10 +41,15 @@ fn lattices() -> Vec<(&'static str, Lattice)> {
     for q in &mut grid.positions {
         q.coords += 0.08 * rng.vector();
     }
+    // Local refinement: the centre cell of a 3³ grid, whose neighbours
+    // become cells with valence-4 face points and valence-2 edge points.
+    let big = box_grid(p(0.0, 0.0, 0.0), p(1.5, 1.5, 1.5), [3, 3, 3]).unwrap();
+    let (local, _) = locally_refined(&big, &[13]).unwrap();
     vec![
         ("grid", grid),
         ("cylinder", cylinder(1.0, 1.0, 5, 1).unwrap()),
         ("pyramid", pyramid()),
+        ("local", local),
     ]
 }
 
@@ -68,7 +73,7 @@ fn an_unmoved_lattice_leaves_every_vertex_in_place() {
                 (a - b).norm()
             );
         }
-        if name == "pyramid" {
+        if name == "pyramid" || name == "local" {
             assert!(ffd.report.in_type_n_cells > 0, "no point in a type-4 cell");
         }
     }

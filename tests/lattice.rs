@@ -411,6 +411,31 @@ fn lattice_cli_writes_a_readable_lattice_and_refuses_bad_input() {
     );
     let lat = subdyn::io::read_lattice(d.join("lat.json")).unwrap();
     assert!(lat.topology.num_cells() > 8 && lat.topology.num_cells() <= 64);
+    let out = run(&[
+        "lattice",
+        "m.obj",
+        "-o",
+        "local.json",
+        "--octree-levels",
+        "1",
+        "--shrink",
+        "0.01",
+        "--refine-cells",
+        "0,7",
+        "--report",
+        "r.json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let local = subdyn::io::read_lattice(d.join("local.json")).unwrap();
+    assert_eq!(local.topology.num_cells(), 8 - 2 + 16);
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("r.json")).unwrap()).unwrap();
+    assert_eq!(report["local_refinement"]["refined"], 2, "{report}");
+    assert!(report["shrink"]["moved"].as_u64().unwrap() > 0, "{report}");
     for (args, needle) in [
         (vec!["lattice", "m.obj", "-o", "lat.obj"], "json"),
         (
@@ -420,6 +445,14 @@ fn lattice_cli_writes_a_readable_lattice_and_refuses_bad_input() {
         (
             vec!["lattice", "missing.obj", "-o", "x.json"],
             "missing.obj",
+        ),
+        (
+            vec!["lattice", "m.obj", "-o", "x.json", "--refine-cells", "8"],
+            "cell 8",
+        ),
+        (
+            vec!["lattice", "m.obj", "-o", "x.json", "--shrink=-1"],
+            "shrink",
         ),
     ] {
         let out = run(&args);
@@ -528,4 +561,162 @@ fn derived_incidences_match_a_brute_force_recount() {
         let h = LatticeHierarchy::new(&lat, 1).unwrap();
         assert_incidences_match_a_recount(name, &h.level(1).topology);
     }
+}
+
+// ------------------------------------------------ shrink and local refinement
+
+#[test]
+fn a_shrunk_single_box_is_the_model_box_grown_by_the_offset() {
+    use subdyn::lattice::{BoxLatticeParams, shrunk_box_lattice};
+    let mut rng = Rng::new(11);
+    let model: Vec<Point3> = (0..200)
+        .map(|_| {
+            p(
+                rng.uniform(-1.0, 2.0),
+                rng.uniform(0.0, 0.5),
+                rng.uniform(3.0, 4.0),
+            )
+        })
+        .collect();
+    let diag = common::diag(&model);
+    let params = BoxLatticeParams {
+        margin: 0.2,
+        ..Default::default()
+    };
+    let (lat, report) = shrunk_box_lattice(&model, &params, 0.03).unwrap();
+    let (lo, hi) = subdyn::math::bounding_box(&model).unwrap();
+    let (llo, lhi) = subdyn::math::bounding_box(&lat.positions).unwrap();
+    for k in 0..3 {
+        assert!(
+            (llo[k] - (lo[k] - 0.03 * diag)).abs() < 1e-12 * diag,
+            "axis {k}"
+        );
+        assert!(
+            (lhi[k] - (hi[k] + 0.03 * diag)).abs() < 1e-12 * diag,
+            "axis {k}"
+        );
+    }
+    assert_eq!(report.moved, 8);
+    assert!((report.max_move - 0.17).abs() < 1e-9, "{report:?}");
+}
+
+#[test]
+fn shrunk_octree_lattices_move_boundary_points_inwards_only_and_stay_valid() {
+    use subdyn::lattice::{BoxLatticeParams, box_lattice, shrunk_box_lattice};
+    let sphere: Vec<Point3> = (0..2000)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / 2000.0;
+            let r = (1.0 - z * z).sqrt();
+            let a = i as f64 * 2.399_963;
+            p(r * a.cos(), r * a.sin(), z)
+        })
+        .collect();
+    for levels in [1, 2, 3] {
+        let params = BoxLatticeParams {
+            octree_levels: levels,
+            ..Default::default()
+        };
+        let plain = box_lattice(&sphere, &params).unwrap();
+        let (lat, report) = shrunk_box_lattice(&sphere, &params, 0.02).unwrap();
+        assert_eq!(lat.topology, plain.topology, "K = {levels}: same cells");
+        assert!(report.moved > 0, "K = {levels}");
+        // Only boundary points move, each axis component into the lattice:
+        // towards the centroids of the point's own cells (an inner cavity's
+        // boundary moves outwards, towards the shell).
+        let mut moved = 0;
+        let t = &plain.topology;
+        for (v, (a, b)) in plain.positions.iter().zip(&lat.positions).enumerate() {
+            if a == b {
+                continue;
+            }
+            moved += 1;
+            let on_boundary = t
+                .vertex_faces
+                .row(v)
+                .iter()
+                .any(|&f| t.is_boundary_face(f as usize));
+            assert!(on_boundary, "K = {levels}, vertex {v}");
+            let cs = t.vertex_cells.row(v);
+            let inner = cs.iter().fold(Vector3::zeros(), |s, &c| {
+                let vs = t.cell_vertices.row(c as usize);
+                s + vs.iter().fold(Vector3::zeros(), |s, &w| {
+                    s + plain.positions[w as usize].coords
+                }) / vs.len() as f64
+            }) / cs.len() as f64;
+            for k in 0..3 {
+                assert!(
+                    (b - a)[k] * (inner[k] - a[k]) >= 0.0,
+                    "K = {levels}, vertex {v}, axis {k}"
+                );
+            }
+        }
+        assert_eq!(moved, report.moved, "K = {levels}");
+        // Boundary points keep at least the offset from every model vertex
+        // along their axis: no model vertex is cut off by a box face.
+        let (lo, hi) = subdyn::math::bounding_box(&lat.positions).unwrap();
+        let (mlo, mhi) = subdyn::math::bounding_box(&sphere).unwrap();
+        for k in 0..3 {
+            assert!(lo[k] <= mlo[k] - 0.02 * common::diag(&sphere) + 1e-9);
+            assert!(hi[k] >= mhi[k] + 0.02 * common::diag(&sphere) - 1e-9);
+        }
+    }
+    assert!(shrunk_box_lattice(&sphere, &BoxLatticeParams::default(), f64::NAN).is_err());
+}
+
+#[test]
+fn local_refinement_makes_the_papers_cells_and_a_valid_lattice() {
+    use subdyn::lattice::locally_refined;
+    let grid = box_grid(p(0.0, 0.0, 0.0), p(3.0, 3.0, 3.0), [3, 3, 3]).unwrap();
+    // The centre cell: 6 face neighbours, 12 edge neighbours, 8 corner neighbours.
+    let (lat, r) = locally_refined(&grid, &[13]).unwrap();
+    assert_eq!(r.refined, 1);
+    assert_eq!(lat.topology.num_cells(), 26 + 8);
+    // Face neighbours (9 faces) and edge neighbours (2 pentagons) are not hexahedra.
+    assert_eq!(r.non_hexahedral, 6 + 12);
+    // Face points have valence 4 in a face neighbour; edge points valence 2
+    // in an edge neighbour (and 3 in the two face neighbours at the edge).
+    assert_eq!(r.extraordinary_corners, 6 + 12);
+    // The children are the unit-cube octants of the centre cell.
+    let vols = lat.cell_volumes().unwrap();
+    assert!(
+        vols[26..].iter().all(|v| (v - 0.125).abs() < 1e-12),
+        "{vols:?}"
+    );
+    assert!((vols.iter().sum::<f64>() - 27.0).abs() < 1e-9);
+    incidence_and_refinement_checks(&lat);
+    // A corner cell on the boundary, and two cells sharing a face.
+    for chosen in [vec![0], vec![4, 13], vec![0, 26]] {
+        let (lat, _) = locally_refined(&grid, &chosen).unwrap();
+        incidence_and_refinement_checks(&lat);
+    }
+    // Refining a locally refined lattice again, inside a child.
+    let (again, _) = locally_refined(&lat, &[26, 3]).unwrap();
+    incidence_and_refinement_checks(&again);
+    assert!(locally_refined(&grid, &[27]).is_err());
+    assert!(locally_refined(&grid, &[]).is_err());
+}
+
+/// Topology recount, and one level of refinement: rows sum to one, type-n
+/// cells exactly at the corners of valence `n`.
+fn incidence_and_refinement_checks(lat: &Lattice) {
+    assert_incidences_match_a_recount("local", &lat.topology);
+    let h = LatticeHierarchy::new(lat, 2).unwrap();
+    for s in &h.stencils {
+        assert!(s.row_sums().iter().all(|x| (x - 1.0).abs() < 1e-12));
+    }
+    let t = &lat.topology;
+    let mut want = std::collections::BTreeMap::new();
+    for c in 0..t.num_cells() {
+        for &v in t.cell_vertices.row(c) {
+            *want
+                .entry(t.corner_ring(c, v).unwrap().len() / 2)
+                .or_insert(0) += 1;
+        }
+    }
+    let tn = h.level(1).type_n.as_ref().unwrap();
+    let mut got = std::collections::BTreeMap::new();
+    for c in 0..tn.len() {
+        *got.entry(tn.valence(c)).or_insert(0) += 1;
+    }
+    assert_eq!(got, want);
 }

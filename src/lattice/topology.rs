@@ -436,7 +436,8 @@ impl LatticeTopology {
     /// The faces of cell `c` around its vertex `v` in cyclic order, as the
     /// ring `[e_1, f_1, e_2, f_2, …, e_n, f_n]` where face `f_i` holds edges
     /// `e_i` and `e_{i+1}` (indices into edges and faces). `n` is the valence
-    /// of `v` in `c` (MacCracken & Joy 1996, §2.2).
+    /// of `v` in `c` (MacCracken & Joy 1996, §2.2); `n = 2` happens at an
+    /// edge point that local refinement inserted into a neighbour's edge.
     pub fn corner_ring(&self, c: usize, v: u32) -> Result<Vec<u32>> {
         let cell_faces = self.cells.row(c);
         // (face, edge-in, edge-out) for the faces of c at v.
@@ -455,7 +456,7 @@ impl LatticeTopology {
                 "cell {c}: its faces at vertex {v} do not form one fan (the cell is pinched there)"
             ))
         };
-        if n < 3 {
+        if n < 2 {
             return Err(bad());
         }
         let mut ring = Vec::with_capacity(2 * n);
