@@ -24,6 +24,7 @@ mod hierarchy;
 #[allow(clippy::module_inception)]
 mod lattice;
 mod local_refine;
+mod octree;
 mod refine_topology;
 mod rules;
 mod shrink;
@@ -34,6 +35,7 @@ pub use builders::{HEX_FACES, LatticeBuilder, box_grid, cylinder, extrude, hexah
 pub use hierarchy::{LatticeHierarchy, LatticeLevel, MAX_LATTICE_LEVELS};
 pub use lattice::{BoundaryTags, Lattice, cell_volume, check_geometry};
 pub use local_refine::{LocalRefineReport, locally_refined};
+pub use octree::{octree_refined, octree_stencil};
 pub use refine_topology::{TypeNCells, refined_topology};
 pub use rules::{refined_tags, refinement_stencil};
 pub use shrink::{ShrinkReport, shrunk_box_lattice};
