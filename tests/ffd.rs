@@ -469,7 +469,7 @@ fn bench_ffd_local_updates_match_the_full_product() {
     assert_eq!(json["refined_32_cells"], 32768, "{last}");
     let bytes = json["refined_32_topology_bytes"].as_u64().unwrap();
     assert!(
-        bytes > json["refined_32_type_n_bytes"].as_u64().unwrap(),
+        bytes > 8 * json["refined_32_compact_bytes"].as_u64().unwrap(),
         "{last}"
     );
     for key in ["refine_s", "embed_s", "local_update_ms", "full_product_ms"] {

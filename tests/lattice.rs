@@ -757,3 +757,22 @@ fn octree_subdivision_of_a_box_grid_is_the_half_spacing_grid() {
         "octree and Catmull-Clark rules agree on a bent lattice: {g}"
     );
 }
+
+#[test]
+fn compact_refined_cells_match_the_full_refined_topology() {
+    use subdyn::lattice::{refined_cells, refined_topology};
+    for (name, lat) in test_lattices() {
+        let (full, tn) = refined_topology(&lat.topology).unwrap();
+        let (cells, boundary) = refined_cells(&lat.topology).unwrap();
+        assert_eq!(cells, tn, "{name}");
+        let mut want: Vec<Vec<u32>> = full
+            .boundary_faces()
+            .iter()
+            .map(|&f| full.faces.row(f as usize).to_vec())
+            .collect();
+        let mut got: Vec<Vec<u32>> = boundary.iter().map(|q| q.to_vec()).collect();
+        want.sort();
+        got.sort();
+        assert_eq!(got, want, "{name}");
+    }
+}

@@ -26,5 +26,5 @@ mod hierarchical;
 pub use cell_coords::{CellCoords, cell_coords, cell_triangles, trilinear_coords};
 pub use cell_index::CellIndex;
 pub use deform::{Ffd, FfdParams, FfdReport};
-pub use embed::{Embedding, embedding};
+pub use embed::{Embedding, embedding, embedding_in_cells};
 pub use hierarchical::{Enclosing, LayeredFfd};

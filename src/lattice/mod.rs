@@ -36,7 +36,7 @@ pub use hierarchy::{LatticeHierarchy, LatticeLevel, MAX_LATTICE_LEVELS};
 pub use lattice::{BoundaryTags, Lattice, cell_volume, check_geometry};
 pub use local_refine::{LocalRefineReport, locally_refined};
 pub use octree::{octree_refined, octree_stencil};
-pub use refine_topology::{TypeNCells, refined_topology};
+pub use refine_topology::{TypeNCells, refined_cells, refined_topology};
 pub use rules::{refined_tags, refinement_stencil};
 pub use shrink::{ShrinkReport, shrunk_box_lattice};
 pub use topology::{Csr, LatticeTopology, NO_CELL};
