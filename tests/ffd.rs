@@ -7,9 +7,9 @@ mod common;
 use common::Rng;
 use common::volume::pyramid;
 use common::volume::tricubic;
-use subdyn::ffd::{Ffd, FfdParams};
-use subdyn::lattice::{Lattice, box_grid, cylinder};
-use subdyn::math::{Point3, bbox_diagonal, bounding_box};
+use subdyn::ffd::{Enclosing, Ffd, FfdParams, LayeredFfd};
+use subdyn::lattice::{Lattice, box_grid, cylinder, locally_refined};
+use subdyn::math::{Point3, Vector3, bbox_diagonal, bounding_box};
 
 fn p(x: f64, y: f64, z: f64) -> Point3 {
     Point3::new(x, y, z)
@@ -41,10 +41,15 @@ fn lattices() -> Vec<(&'static str, Lattice)> {
     for q in &mut grid.positions {
         q.coords += 0.08 * rng.vector();
     }
+    // Local refinement: the centre cell of a 3³ grid, whose neighbours
+    // become cells with valence-4 face points and valence-2 edge points.
+    let big = box_grid(p(0.0, 0.0, 0.0), p(1.5, 1.5, 1.5), [3, 3, 3]).unwrap();
+    let (local, _) = locally_refined(&big, &[13]).unwrap();
     vec![
         ("grid", grid),
         ("cylinder", cylinder(1.0, 1.0, 5, 1).unwrap()),
         ("pyramid", pyramid()),
+        ("local", local),
     ]
 }
 
@@ -68,7 +73,7 @@ fn an_unmoved_lattice_leaves_every_vertex_in_place() {
                 (a - b).norm()
             );
         }
-        if name == "pyramid" {
+        if name == "pyramid" || name == "local" {
             assert!(ffd.report.in_type_n_cells > 0, "no point in a type-4 cell");
         }
     }
@@ -424,4 +429,175 @@ f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\nf 9 1 2\n";
             "--levels 9",
         );
     }
+}
+
+#[test]
+fn bench_ffd_local_updates_match_the_full_product() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = common::run_subdyn(
+        dir.path(),
+        &[
+            "bench",
+            "ffd",
+            "--vertices",
+            "3000",
+            "--octree-levels",
+            "1",
+            "--levels",
+            "2",
+            "--updates",
+            "20",
+            "--quiet",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let last = text.lines().last().expect("some output");
+    let json: serde_json::Value = serde_json::from_str(last).expect("the last line is JSON");
+    // A torus inside its own bounding box: every vertex is embedded.
+    assert_eq!(json["embedded"], json["vertices"], "{last}");
+    assert_eq!(json["outside"], 0, "{last}");
+    assert!(
+        json["max_abs_diff_local_vs_full"].as_f64().unwrap() < 1e-12,
+        "{last}"
+    );
+    // The 32³-cell refined lattice: 4³ cells refined three times.
+    assert_eq!(json["refined_32_cells"], 32768, "{last}");
+    let bytes = json["refined_32_topology_bytes"].as_u64().unwrap();
+    assert!(
+        bytes > 8 * json["refined_32_compact_bytes"].as_u64().unwrap(),
+        "{last}"
+    );
+    for key in ["refine_s", "embed_s", "local_update_ms", "full_product_ms"] {
+        assert!(
+            json[key].as_f64().is_some_and(|s| s > 0.0),
+            "{key} in {last}"
+        );
+    }
+    let bad = common::run_subdyn(dir.path(), &["bench", "ffd", "--levels", "9"]);
+    assert_eq!(bad.status.code(), Some(1));
+}
+
+// ------------------------------------------------ hierarchical deformation
+
+fn inner_points(rng: &mut Rng, lo: Point3, hi: Point3, n: usize) -> Vec<Point3> {
+    (0..n)
+        .map(|_| {
+            p(
+                rng.uniform(lo.x, hi.x),
+                rng.uniform(lo.y, hi.y),
+                rng.uniform(lo.z, hi.z),
+            )
+        })
+        .collect()
+}
+
+fn max_gap(a: &[Point3], b: &[Point3]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).norm())
+        .fold(0.0, f64::max)
+}
+
+/// A coarse 2×1×1 lattice deformed non-affinely, then its octree
+/// subdivision: the finer layer carries a non-zero correction.
+fn coarse_then_fine(rng: &mut Rng) -> (Vec<Point3>, LayeredFfd, LayeredFfd) {
+    let lat = box_grid(p(0.0, 0.0, 0.0), p(2.0, 1.0, 1.0), [2, 1, 1]).unwrap();
+    let pts = inner_points(rng, p(0.1, 0.1, 0.1), p(1.9, 0.9, 0.9), 400);
+    let mut coarse = LayeredFfd::global(lat.clone(), &pts, &params(2)).unwrap();
+    coarse.control[4] += Vector3::new(0.1, 0.2, 0.3);
+    coarse.control[9] -= Vector3::new(0.0, 0.25, 0.1);
+    let fine = coarse.finer(&params(2)).unwrap();
+    (pts, coarse, fine)
+}
+
+#[test]
+fn global_to_local_keeps_the_model_and_corrects_only_the_non_affine_gap() {
+    let mut rng = Rng::new(21);
+    let lat = box_grid(p(0.0, 0.0, 0.0), p(2.0, 1.0, 1.0), [2, 1, 1]).unwrap();
+    let pts = inner_points(&mut rng, p(0.1, 0.1, 0.1), p(1.9, 0.9, 0.9), 400);
+    let d = bbox_diagonal(&pts);
+    let mut g = LayeredFfd::global(lat.clone(), &pts, &params(2)).unwrap();
+    assert!(g.max_correction() < 1e-12 * d);
+    assert!(max_gap(&g.model().unwrap(), &pts) < 1e-10 * d);
+    // An affine global deformation: octree and Catmull-Clark rules agree, no correction.
+    let (a, b) = common::random_affine(&mut rng);
+    g.control = common::affine(&lat.positions, &a, &b);
+    let before = g.model().unwrap();
+    let fine = g.finer(&params(2)).unwrap();
+    assert_eq!(fine.ffd.report.outside, 0);
+    assert!(
+        fine.max_correction() < 1e-10 * d,
+        "{}",
+        fine.max_correction()
+    );
+    assert!(max_gap(&fine.model().unwrap(), &before) < 1e-10 * d);
+    // A non-affine one: the gap is real and the correction removes it.
+    let (pts2, coarse, fine) = coarse_then_fine(&mut rng);
+    let before = coarse.model().unwrap();
+    assert!(max_gap(&before, &pts2) > 0.05);
+    assert!(
+        fine.max_correction() > 1e-3 * d,
+        "{}",
+        fine.max_correction()
+    );
+    assert!(max_gap(&fine.model().unwrap(), &before) < 1e-10 * d);
+    // A local move on the finer lattice moves exactly the vertices of its
+    // column of B, each by its weight times the move.
+    let c = (0..fine.control.len())
+        .max_by_key(|&c| fine.ffd.bt.row(c).0.len())
+        .unwrap();
+    let delta = Vector3::new(0.0, 0.0, 0.2);
+    let mut moved = fine.clone();
+    moved.control[c] += delta;
+    let after = moved.model().unwrap();
+    let (rows, w) = fine.ffd.bt.row(c);
+    assert!(!rows.is_empty());
+    let mut expect = before.clone();
+    for (&r, &w) in rows.iter().zip(w) {
+        expect[r as usize] += w * delta;
+    }
+    assert!(max_gap(&after, &expect) < 1e-10 * d);
+}
+
+#[test]
+fn local_to_global_carries_the_model_and_the_fine_lattice() {
+    let mut rng = Rng::new(22);
+    let (_, _, mut fine) = coarse_then_fine(&mut rng);
+    fine.control[30] += Vector3::new(0.05, -0.1, 0.1); // a local edit
+    let model = fine.model().unwrap();
+    let d = bbox_diagonal(&model);
+    let enc = Enclosing::around(
+        &fine,
+        &subdyn::lattice::BoxLatticeParams::default(),
+        &params(2),
+    )
+    .unwrap();
+    assert_eq!(enc.ffd.report.outside, 0);
+    let (m, c) = enc.carried(&enc.lattice.positions).unwrap();
+    assert!(max_gap(&m, &model) < 1e-10 * d);
+    assert!(max_gap(&c, &fine.control) < 1e-10 * d);
+    // An affine global edit moves both by the same map, and back in local
+    // mode the correction is the old one turned by the linear part.
+    let (a, b) = common::random_affine(&mut rng);
+    let moved = common::affine(&enc.lattice.positions, &a, &b);
+    let (m, c) = enc.carried(&moved).unwrap();
+    assert!(max_gap(&m, &common::affine(&model, &a, &b)) < 1e-9 * d);
+    assert!(max_gap(&c, &common::affine(&fine.control, &a, &b)) < 1e-9 * d);
+    let back = enc.back_to_local(&fine, &moved).unwrap();
+    assert!(max_gap(&back.model().unwrap(), &m) < 1e-10 * d);
+    for (new, old) in back.correction.iter().zip(&fine.correction) {
+        assert!((new - a * old).norm() < 1e-9 * d);
+    }
+    // A non-affine global edit: the fine lattice bends with the model.
+    let mut bent = enc.lattice.positions.clone();
+    bent[0] += Vector3::new(0.0, 0.0, -0.4);
+    let (m, c) = enc.carried(&bent).unwrap();
+    assert!(max_gap(&m, &model) > 1e-3 && max_gap(&c, &fine.control) > 1e-3);
+    assert!(enc.back_to_local(&fine, &[]).is_err());
 }

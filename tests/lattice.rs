@@ -411,6 +411,31 @@ fn lattice_cli_writes_a_readable_lattice_and_refuses_bad_input() {
     );
     let lat = subdyn::io::read_lattice(d.join("lat.json")).unwrap();
     assert!(lat.topology.num_cells() > 8 && lat.topology.num_cells() <= 64);
+    let out = run(&[
+        "lattice",
+        "m.obj",
+        "-o",
+        "local.json",
+        "--octree-levels",
+        "1",
+        "--shrink",
+        "0.01",
+        "--refine-cells",
+        "0,7",
+        "--report",
+        "r.json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let local = subdyn::io::read_lattice(d.join("local.json")).unwrap();
+    assert_eq!(local.topology.num_cells(), 8 - 2 + 16);
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("r.json")).unwrap()).unwrap();
+    assert_eq!(report["local_refinement"]["refined"], 2, "{report}");
+    assert!(report["shrink"]["moved"].as_u64().unwrap() > 0, "{report}");
     for (args, needle) in [
         (vec!["lattice", "m.obj", "-o", "lat.obj"], "json"),
         (
@@ -421,6 +446,14 @@ fn lattice_cli_writes_a_readable_lattice_and_refuses_bad_input() {
             vec!["lattice", "missing.obj", "-o", "x.json"],
             "missing.obj",
         ),
+        (
+            vec!["lattice", "m.obj", "-o", "x.json", "--refine-cells", "8"],
+            "cell 8",
+        ),
+        (
+            vec!["lattice", "m.obj", "-o", "x.json", "--shrink=-1"],
+            "shrink",
+        ),
     ] {
         let out = run(&args);
         let err = String::from_utf8_lossy(&out.stderr);
@@ -428,5 +461,318 @@ fn lattice_cli_writes_a_readable_lattice_and_refuses_bad_input() {
         assert_eq!(err.lines().count(), 1, "{err}");
         assert!(err.contains(needle), "`{needle}` not in {err}");
         assert!(!d.join("x.json").exists());
+    }
+}
+
+/// Every derived incidence of `LatticeTopology::new` recounted by brute
+/// force from the face loops and cell face lists alone.
+fn assert_incidences_match_a_recount(name: &str, t: &LatticeTopology) {
+    use std::collections::BTreeSet;
+    let mut edges: Vec<[u32; 2]> = Vec::new();
+    for f in 0..t.num_faces() {
+        let l = t.faces.row(f);
+        for i in 0..l.len() {
+            let (a, b) = (l[i], l[(i + 1) % l.len()]);
+            let e = [a.min(b), a.max(b)];
+            if !edges.contains(&e) {
+                edges.push(e);
+            }
+            assert_eq!(
+                t.edges[t.face_edges.row(f)[i] as usize],
+                e,
+                "{name}: face {f} edge {i}"
+            );
+        }
+    }
+    assert_eq!(t.edges, edges, "{name}: edges in first-appearance order");
+    for (e, &[a, b]) in edges.iter().enumerate() {
+        let faces: Vec<u32> = (0..t.num_faces() as u32)
+            .filter(|&f| {
+                let l = t.faces.row(f as usize);
+                (0..l.len()).any(|i| {
+                    let (x, y) = (l[i], l[(i + 1) % l.len()]);
+                    (x, y) == (a, b) || (x, y) == (b, a)
+                })
+            })
+            .collect();
+        assert_eq!(
+            t.edge_faces.row(e),
+            faces.as_slice(),
+            "{name}: edge {e} faces"
+        );
+        let cells: BTreeSet<u32> = (0..t.num_cells() as u32)
+            .filter(|&c| t.cells.row(c as usize).iter().any(|f| faces.contains(f)))
+            .collect();
+        let got: BTreeSet<u32> = t.edge_cells.row(e).iter().copied().collect();
+        assert_eq!(got, cells, "{name}: edge {e} cells");
+        assert_eq!(
+            t.edge_cells.row(e).len(),
+            cells.len(),
+            "{name}: edge {e} cells repeated"
+        );
+    }
+    for c in 0..t.num_cells() {
+        let verts: BTreeSet<u32> = t
+            .cells
+            .row(c)
+            .iter()
+            .flat_map(|&f| t.faces.row(f as usize).to_vec())
+            .collect();
+        let want: Vec<u32> = verts.into_iter().collect();
+        assert_eq!(
+            t.cell_vertices.row(c),
+            want.as_slice(),
+            "{name}: cell {c} vertices"
+        );
+    }
+    for v in 0..t.num_vertices {
+        let v32 = v as u32;
+        let cells: Vec<u32> = (0..t.num_cells() as u32)
+            .filter(|&c| t.cell_vertices.row(c as usize).contains(&v32))
+            .collect();
+        assert_eq!(
+            t.vertex_cells.row(v),
+            cells.as_slice(),
+            "{name}: vertex {v} cells"
+        );
+        let faces: Vec<u32> = (0..t.num_faces() as u32)
+            .filter(|&f| t.faces.row(f as usize).contains(&v32))
+            .collect();
+        assert_eq!(
+            t.vertex_faces.row(v),
+            faces.as_slice(),
+            "{name}: vertex {v} faces"
+        );
+        let es: Vec<u32> = (0..edges.len() as u32)
+            .filter(|&e| edges[e as usize].contains(&v32))
+            .collect();
+        assert_eq!(
+            t.vertex_edges.row(v),
+            es.as_slice(),
+            "{name}: vertex {v} edges"
+        );
+    }
+}
+
+#[test]
+fn derived_incidences_match_a_brute_force_recount() {
+    for (name, lat) in test_lattices() {
+        assert_incidences_match_a_recount(name, &lat.topology);
+        let h = LatticeHierarchy::new(&lat, 1).unwrap();
+        assert_incidences_match_a_recount(name, &h.level(1).topology);
+    }
+}
+
+// ------------------------------------------------ shrink and local refinement
+
+#[test]
+fn a_shrunk_single_box_is_the_model_box_grown_by_the_offset() {
+    use subdyn::lattice::{BoxLatticeParams, shrunk_box_lattice};
+    let mut rng = Rng::new(11);
+    let model: Vec<Point3> = (0..200)
+        .map(|_| {
+            p(
+                rng.uniform(-1.0, 2.0),
+                rng.uniform(0.0, 0.5),
+                rng.uniform(3.0, 4.0),
+            )
+        })
+        .collect();
+    let diag = common::diag(&model);
+    let params = BoxLatticeParams {
+        margin: 0.2,
+        ..Default::default()
+    };
+    let (lat, report) = shrunk_box_lattice(&model, &params, 0.03).unwrap();
+    let (lo, hi) = subdyn::math::bounding_box(&model).unwrap();
+    let (llo, lhi) = subdyn::math::bounding_box(&lat.positions).unwrap();
+    for k in 0..3 {
+        assert!(
+            (llo[k] - (lo[k] - 0.03 * diag)).abs() < 1e-12 * diag,
+            "axis {k}"
+        );
+        assert!(
+            (lhi[k] - (hi[k] + 0.03 * diag)).abs() < 1e-12 * diag,
+            "axis {k}"
+        );
+    }
+    assert_eq!(report.moved, 8);
+    assert!((report.max_move - 0.17).abs() < 1e-9, "{report:?}");
+}
+
+#[test]
+fn shrunk_octree_lattices_move_boundary_points_inwards_only_and_stay_valid() {
+    use subdyn::lattice::{BoxLatticeParams, box_lattice, shrunk_box_lattice};
+    let sphere: Vec<Point3> = (0..2000)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / 2000.0;
+            let r = (1.0 - z * z).sqrt();
+            let a = i as f64 * 2.399_963;
+            p(r * a.cos(), r * a.sin(), z)
+        })
+        .collect();
+    for levels in [1, 2, 3] {
+        let params = BoxLatticeParams {
+            octree_levels: levels,
+            ..Default::default()
+        };
+        let plain = box_lattice(&sphere, &params).unwrap();
+        let (lat, report) = shrunk_box_lattice(&sphere, &params, 0.02).unwrap();
+        assert_eq!(lat.topology, plain.topology, "K = {levels}: same cells");
+        assert!(report.moved > 0, "K = {levels}");
+        // Only boundary points move, each axis component into the lattice:
+        // towards the centroids of the point's own cells (an inner cavity's
+        // boundary moves outwards, towards the shell).
+        let mut moved = 0;
+        let t = &plain.topology;
+        for (v, (a, b)) in plain.positions.iter().zip(&lat.positions).enumerate() {
+            if a == b {
+                continue;
+            }
+            moved += 1;
+            let on_boundary = t
+                .vertex_faces
+                .row(v)
+                .iter()
+                .any(|&f| t.is_boundary_face(f as usize));
+            assert!(on_boundary, "K = {levels}, vertex {v}");
+            let cs = t.vertex_cells.row(v);
+            let inner = cs.iter().fold(Vector3::zeros(), |s, &c| {
+                let vs = t.cell_vertices.row(c as usize);
+                s + vs.iter().fold(Vector3::zeros(), |s, &w| {
+                    s + plain.positions[w as usize].coords
+                }) / vs.len() as f64
+            }) / cs.len() as f64;
+            for k in 0..3 {
+                assert!(
+                    (b - a)[k] * (inner[k] - a[k]) >= 0.0,
+                    "K = {levels}, vertex {v}, axis {k}"
+                );
+            }
+        }
+        assert_eq!(moved, report.moved, "K = {levels}");
+        // Boundary points keep at least the offset from every model vertex
+        // along their axis: no model vertex is cut off by a box face.
+        let (lo, hi) = subdyn::math::bounding_box(&lat.positions).unwrap();
+        let (mlo, mhi) = subdyn::math::bounding_box(&sphere).unwrap();
+        for k in 0..3 {
+            assert!(lo[k] <= mlo[k] - 0.02 * common::diag(&sphere) + 1e-9);
+            assert!(hi[k] >= mhi[k] + 0.02 * common::diag(&sphere) - 1e-9);
+        }
+    }
+    assert!(shrunk_box_lattice(&sphere, &BoxLatticeParams::default(), f64::NAN).is_err());
+}
+
+#[test]
+fn local_refinement_makes_the_papers_cells_and_a_valid_lattice() {
+    use subdyn::lattice::locally_refined;
+    let grid = box_grid(p(0.0, 0.0, 0.0), p(3.0, 3.0, 3.0), [3, 3, 3]).unwrap();
+    // The centre cell: 6 face neighbours, 12 edge neighbours, 8 corner neighbours.
+    let (lat, r) = locally_refined(&grid, &[13]).unwrap();
+    assert_eq!(r.refined, 1);
+    assert_eq!(lat.topology.num_cells(), 26 + 8);
+    // Face neighbours (9 faces) and edge neighbours (2 pentagons) are not hexahedra.
+    assert_eq!(r.non_hexahedral, 6 + 12);
+    // Face points have valence 4 in a face neighbour; edge points valence 2
+    // in an edge neighbour (and 3 in the two face neighbours at the edge).
+    assert_eq!(r.extraordinary_corners, 6 + 12);
+    // The children are the unit-cube octants of the centre cell.
+    let vols = lat.cell_volumes().unwrap();
+    assert!(
+        vols[26..].iter().all(|v| (v - 0.125).abs() < 1e-12),
+        "{vols:?}"
+    );
+    assert!((vols.iter().sum::<f64>() - 27.0).abs() < 1e-9);
+    incidence_and_refinement_checks(&lat);
+    // A corner cell on the boundary, and two cells sharing a face.
+    for chosen in [vec![0], vec![4, 13], vec![0, 26]] {
+        let (lat, _) = locally_refined(&grid, &chosen).unwrap();
+        incidence_and_refinement_checks(&lat);
+    }
+    // Refining a locally refined lattice again, inside a child.
+    let (again, _) = locally_refined(&lat, &[26, 3]).unwrap();
+    incidence_and_refinement_checks(&again);
+    assert!(locally_refined(&grid, &[27]).is_err());
+    assert!(locally_refined(&grid, &[]).is_err());
+}
+
+/// Topology recount, and one level of refinement: rows sum to one, type-n
+/// cells exactly at the corners of valence `n`.
+fn incidence_and_refinement_checks(lat: &Lattice) {
+    assert_incidences_match_a_recount("local", &lat.topology);
+    let h = LatticeHierarchy::new(lat, 2).unwrap();
+    for s in &h.stencils {
+        assert!(s.row_sums().iter().all(|x| (x - 1.0).abs() < 1e-12));
+    }
+    let t = &lat.topology;
+    let mut want = std::collections::BTreeMap::new();
+    for c in 0..t.num_cells() {
+        for &v in t.cell_vertices.row(c) {
+            *want
+                .entry(t.corner_ring(c, v).unwrap().len() / 2)
+                .or_insert(0) += 1;
+        }
+    }
+    let tn = h.level(1).type_n.as_ref().unwrap();
+    let mut got = std::collections::BTreeMap::new();
+    for c in 0..tn.len() {
+        *got.entry(tn.valence(c)).or_insert(0) += 1;
+    }
+    assert_eq!(got, want);
+}
+
+#[test]
+fn octree_subdivision_of_a_box_grid_is_the_half_spacing_grid() {
+    use subdyn::lattice::{octree_refined, refined_topology};
+    let lat = box_grid(p(0.0, 0.0, 0.0), p(2.0, 1.0, 1.5), [2, 1, 3]).unwrap();
+    let (fine, o) = octree_refined(&lat).unwrap();
+    assert!(o.row_sums().iter().all(|s| (s - 1.0).abs() < 1e-14));
+    assert_eq!(fine.topology, refined_topology(&lat.topology).unwrap().0);
+    let half = box_grid(p(0.0, 0.0, 0.0), p(2.0, 1.0, 1.5), [4, 2, 6]).unwrap();
+    assert_eq!(fine.num_vertices(), half.num_vertices());
+    assert!(common::point_set_distance(&fine.positions, &half.positions) < 1e-12);
+    // On the rest box both rules give the regular grid (it is linear data);
+    // on a perturbed lattice they differ: the gap that hierarchical
+    // deformation corrects.
+    let h = LatticeHierarchy::new(&lat, 1).unwrap();
+    let s = h.stencil_to_level(1).unwrap();
+    let gap = |x: &[Point3]| {
+        let cc = s.apply(x).unwrap();
+        let oc = o.apply(x).unwrap();
+        cc.iter()
+            .zip(&oc)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max)
+    };
+    assert!(gap(&lat.positions) < 1e-12);
+    let mut rng = Rng::new(4);
+    let bent: Vec<Point3> = lat
+        .positions
+        .iter()
+        .map(|q| q + 0.1 * rng.vector())
+        .collect();
+    let g = gap(&bent);
+    assert!(
+        g > 1e-3,
+        "octree and Catmull-Clark rules agree on a bent lattice: {g}"
+    );
+}
+
+#[test]
+fn compact_refined_cells_match_the_full_refined_topology() {
+    use subdyn::lattice::{refined_cells, refined_topology};
+    for (name, lat) in test_lattices() {
+        let (full, tn) = refined_topology(&lat.topology).unwrap();
+        let (cells, boundary) = refined_cells(&lat.topology).unwrap();
+        assert_eq!(cells, tn, "{name}");
+        let mut want: Vec<Vec<u32>> = full
+            .boundary_faces()
+            .iter()
+            .map(|&f| full.faces.row(f as usize).to_vec())
+            .collect();
+        let mut got: Vec<Vec<u32>> = boundary.iter().map(|q| q.to_vec()).collect();
+        want.sort();
+        got.sort();
+        assert_eq!(got, want, "{name}");
     }
 }

@@ -44,6 +44,10 @@ pub enum BenchCommand {
     /// Recovering a torus from a synthetic N³ volume, stage by stage, with
     /// peak memory; the last stdout line is one JSON object.
     Recover(super::bench_recover::BenchRecoverArgs),
+    /// Free-form deformation of a 50k-vertex model with an octree lattice:
+    /// embedding, one-point updates, topology memory; the last stdout line
+    /// is one JSON object.
+    Ffd(super::bench_ffd::BenchFfdArgs),
 }
 
 /// Arguments of `subdyn bench subdivide`.
@@ -84,6 +88,7 @@ pub fn run(cmd: &BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Closest(args) => super::bench_closest::bench_closest(args),
         BenchCommand::Distance(args) => super::bench_distance::bench_distance(args),
         BenchCommand::Recover(args) => super::bench_recover::bench_recover(args),
+        BenchCommand::Ffd(args) => super::bench_ffd::bench_ffd(args),
     }
 }
 

@@ -1,6 +1,7 @@
 //! `subdyn lattice MODEL -o LAT.json [--box aabb|obb] [--octree-levels K]
-//! [--margin F] [--no-cull]`: an automatic lattice around a model
-//! (multiresolution-lattice FFD paper: bounding box, octree levels, culling).
+//! [--margin F] [--no-cull] [--shrink OFFSET] [--refine-cells IDS]`: an
+//! automatic lattice around a model (multiresolution-lattice FFD paper:
+//! bounding box, octree levels, culling, shrink lattices, local refinement).
 
 use std::path::PathBuf;
 
@@ -8,7 +9,9 @@ use clap::{Args, ValueEnum};
 use serde_json::json;
 
 use subdyn::io::{read_mesh, write_lattice};
-use subdyn::lattice::{BoxKind, BoxLatticeParams, box_lattice};
+use subdyn::lattice::{
+    BoxKind, BoxLatticeParams, box_lattice, locally_refined, shrunk_box_lattice,
+};
 
 use super::common::{about_file, print_stdout, thousands, write_report};
 
@@ -42,6 +45,16 @@ pub struct LatticeArgs {
     /// Keep the cells that hold no model vertex.
     #[arg(long)]
     pub no_cull: bool,
+    /// Shrink lattice: move boundary control points along their axis
+    /// towards the model, keeping this offset (a fraction of the model's
+    /// diagonal) from the farthest vertex they control.
+    #[arg(long, value_name = "OFFSET")]
+    pub shrink: Option<f64>,
+    /// Refine these cells by the octree rules (comma-separated cell indices
+    /// of the lattice before refinement); their neighbours become
+    /// non-hexahedral cells.
+    #[arg(long, value_name = "IDS", value_delimiter = ',')]
+    pub refine_cells: Vec<usize>,
     /// Write a JSON report.
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
@@ -66,7 +79,24 @@ pub fn run(args: &LatticeArgs) -> anyhow::Result<()> {
         cull: !args.no_cull,
         ..Default::default()
     };
-    let lat = box_lattice(&mesh.positions, &params).map_err(|e| about_file(e, &args.model))?;
+    let (lat, shrink) = match args.shrink {
+        Some(offset) => {
+            let (lat, r) = shrunk_box_lattice(&mesh.positions, &params, offset)
+                .map_err(|e| about_file(e, &args.model))?;
+            (lat, Some(r))
+        }
+        None => (
+            box_lattice(&mesh.positions, &params).map_err(|e| about_file(e, &args.model))?,
+            None,
+        ),
+    };
+    let (lat, local) = if args.refine_cells.is_empty() {
+        (lat, None)
+    } else {
+        let (lat, r) = locally_refined(&lat, &args.refine_cells)
+            .map_err(|e| anyhow::anyhow!("--refine-cells: {e}"))?;
+        (lat, Some(r))
+    };
     write_lattice(&args.output, &lat).map_err(|e| about_file(e, &args.output))?;
     if let Some(report) = &args.report {
         write_report(
@@ -79,11 +109,26 @@ pub fn run(args: &LatticeArgs) -> anyhow::Result<()> {
                 "cells": lat.topology.num_cells(),
                 "octree_levels": args.octree_levels,
                 "cells_before_culling": 1usize << (3 * args.octree_levels),
+                "shrink": shrink,
+                "local_refinement": local,
             }),
         )?;
     }
+    let mut extra = String::new();
+    if let Some(r) = &shrink {
+        extra += &format!(
+            "; shrunk: {} boundary points moved (up to {:.3} of the diagonal)",
+            r.moved, r.max_move
+        );
+    }
+    if let Some(r) = &local {
+        extra += &format!(
+            "; {} cells refined locally, {} non-hexahedral cells",
+            r.refined, r.non_hexahedral
+        );
+    }
     print_stdout(&format!(
-        "lattice around {} ({} vertices): {} control points, {} cells (of {} before culling), written to {}\n",
+        "lattice around {} ({} vertices): {} control points, {} cells (of {} before culling){extra}, written to {}\n",
         args.model.display(),
         thousands(mesh.num_vertices()),
         thousands(lat.num_vertices()),

@@ -4,6 +4,7 @@ mod app;
 mod bench;
 mod bench_closest;
 mod bench_distance;
+mod bench_ffd;
 mod bench_recover;
 mod common;
 mod compare;

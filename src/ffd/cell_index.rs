@@ -13,6 +13,7 @@ pub struct CellIndex {
     dims: [usize; 3],
     offsets: Vec<u32>,
     cells: Vec<u32>,
+    boxes: Vec<(Point3, Point3)>,
 }
 
 impl CellIndex {
@@ -79,6 +80,7 @@ impl CellIndex {
             dims,
             offsets: csr.offsets,
             cells: csr.items,
+            boxes,
         }
     }
 
@@ -96,8 +98,15 @@ impl CellIndex {
         &self.cells[self.offsets[b] as usize..self.offsets[b + 1] as usize]
     }
 
+    /// True when `p` lies in the (grown) bounding box of cell `c`: a cheap
+    /// test before solving for local coordinates.
+    pub fn box_contains(&self, c: u32, p: &Point3) -> bool {
+        let (lo, hi) = &self.boxes[c as usize];
+        (0..3).all(|k| p[k] >= lo[k] && p[k] <= hi[k])
+    }
+
     /// Bytes held by the index.
     pub fn bytes(&self) -> usize {
-        4 * (self.offsets.len() + self.cells.len())
+        4 * (self.offsets.len() + self.cells.len()) + 48 * self.boxes.len()
     }
 }

@@ -7,11 +7,13 @@
 use std::time::Instant;
 
 use crate::error::{Error, Result};
-use crate::lattice::{Lattice, LatticeHierarchy};
+use crate::lattice::{
+    Lattice, LatticeHierarchy, MAX_LATTICE_LEVELS, refined_cells, refinement_stencil,
+};
 use crate::math::{Point3, Real};
 use crate::stencil::StencilTable;
 
-use super::embed::embedding;
+use super::embed::embedding_in_cells;
 
 /// Parameters of [`Ffd::new`].
 #[derive(Clone, Debug)]
@@ -88,6 +90,12 @@ impl Ffd {
                     .into(),
             ));
         }
+        if params.levels > MAX_LATTICE_LEVELS {
+            return Err(Error::Input(format!(
+                "{} lattice levels requested; at most {MAX_LATTICE_LEVELS} are allowed (cells grow eightfold per level)",
+                params.levels
+            )));
+        }
         if !(params.slack.is_finite() && params.slack >= 0.0) {
             return Err(Error::Input(format!(
                 "slack {} must be a finite number ≥ 0",
@@ -103,17 +111,19 @@ impl Ffd {
             )));
         }
         let t0 = Instant::now();
-        let h = LatticeHierarchy::new(lattice, params.levels)?;
-        let s = h.stencil_to_level(params.levels)?;
+        // Levels 0..n-1 in full; level n only as type-n cells and boundary
+        // quads (all the embedding needs; its full incidence structure would
+        // be most of the memory).
+        let h = LatticeHierarchy::new(lattice, params.levels - 1)?;
+        let last = h.level(params.levels - 1);
+        let s = refinement_stencil(&last.topology, &last.tags)
+            .compose(&h.stencil_to_level(params.levels - 1)?)?;
+        let (cells, boundary) = refined_cells(&last.topology)?;
+        let level_cells = cells.len();
         let xn = s.apply(&lattice.positions)?;
         let refine_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
-        let level = h.level(params.levels);
-        let cells = level
-            .type_n
-            .as_ref()
-            .ok_or_else(|| Error::Input("refined level has no type-n cells".into()))?;
-        let emb = embedding(&level.topology, cells, &xn, points, params.slack);
+        let emb = embedding_in_cells(&cells, &boundary, &xn, points, params.slack);
         let b = emb.weights.compose(&s)?;
         let bt = b.transpose();
         let embed_s = t1.elapsed().as_secs_f64();
@@ -125,7 +135,7 @@ impl Ffd {
             in_type_n_cells: emb.in_type_n_cells,
             max_newton_iterations: emb.max_newton_iterations,
             levels: params.levels,
-            level_cells: level.topology.num_cells(),
+            level_cells,
             b_entries: b.num_entries(),
             refine_s,
             embed_s,

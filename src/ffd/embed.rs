@@ -45,14 +45,31 @@ pub fn embedding(
     points: &[Point3],
     slack: Real,
 ) -> Embedding {
-    let margin = 1e-9 * bbox_diagonal(x);
-    let boundary: HashSet<[u32; 4]> = topo
+    let boundary: Vec<[u32; 4]> = topo
         .boundary_faces()
         .iter()
-        .filter_map(|&f| {
-            let mut q: [u32; 4] = topo.faces.row(f as usize).try_into().ok()?;
+        .filter_map(|&f| topo.faces.row(f as usize).try_into().ok())
+        .collect();
+    embedding_in_cells(cells, &boundary, x, points, slack)
+}
+
+/// [`embedding`] from the type-n cells and the boundary quads alone (as
+/// [`refined_cells`](crate::lattice::refined_cells) gives them), without
+/// the level's full topology.
+pub fn embedding_in_cells(
+    cells: &TypeNCells,
+    boundary_quads: &[[u32; 4]],
+    x: &[Point3],
+    points: &[Point3],
+    slack: Real,
+) -> Embedding {
+    let margin = 1e-9 * bbox_diagonal(x);
+    let boundary: HashSet<[u32; 4]> = boundary_quads
+        .iter()
+        .map(|q| {
+            let mut q = *q;
             q.sort_unstable();
-            Some(q)
+            q
         })
         .collect();
     let on_boundary = |q: &Option<[u32; 4]>| {
@@ -67,6 +84,9 @@ pub fn embedding(
         .map(|p| {
             let mut best: Option<(u32, CellCoords)> = None;
             for &c in index.candidates(p) {
+                if !index.box_contains(c, p) {
+                    continue;
+                }
                 let Some(cc) = cell_coords(cells, c as usize, x, p) else {
                     continue;
                 };

@@ -21,8 +21,10 @@ mod cell_coords;
 mod cell_index;
 mod deform;
 mod embed;
+mod hierarchical;
 
 pub use cell_coords::{CellCoords, cell_coords, cell_triangles, trilinear_coords};
 pub use cell_index::CellIndex;
 pub use deform::{Ffd, FfdParams, FfdReport};
-pub use embed::{Embedding, embedding};
+pub use embed::{Embedding, embedding, embedding_in_cells};
+pub use hierarchical::{Enclosing, LayeredFfd};

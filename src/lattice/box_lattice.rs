@@ -112,9 +112,54 @@ pub fn bounding_frame(
     Ok((origin, [0, 1, 2].map(|k| axes.column(k) * ext[k])))
 }
 
-/// A lattice around `points`: the bounding box split into `2^K` cells per
-/// axis, empty cells culled (then dilated), as a hexahedral lattice.
-pub fn box_lattice(points: &[Point3], params: &BoxLatticeParams) -> Result<Lattice> {
+/// The kept cells of the box grid around some points (before any vertex is
+/// moved): the box frame, the cells per axis and one flag per cell.
+pub(super) struct BoxCells {
+    /// Corner of the box.
+    pub origin: Point3,
+    /// The three edge vectors of the box.
+    pub axes: [Vector3; 3],
+    /// Cells per axis (`2^K`).
+    pub n: usize,
+    /// `keep[i + n (j + n k)]`: cell `(i, j, k)` is in the lattice.
+    pub keep: Vec<bool>,
+}
+
+impl BoxCells {
+    /// Index of cell `(i, j, k)`.
+    pub fn cell_id(&self, i: usize, j: usize, k: usize) -> usize {
+        i + self.n * (j + self.n * k)
+    }
+
+    /// Grid coordinates of `p` (`[0, n]` per axis inside the box).
+    pub fn grid_coords(&self, p: &Point3) -> Option<Vector3> {
+        let inv = Matrix3::from_columns(&self.axes).try_inverse()?;
+        Some(inv * (p - self.origin) * self.n as Real)
+    }
+
+    /// Position of grid vertex `(i, j, k)`, with fractional grid coordinates allowed.
+    pub fn position(&self, t: Vector3) -> Point3 {
+        let t = t / self.n as Real;
+        self.origin + self.axes[0] * t.x + self.axes[1] * t.y + self.axes[2] * t.z
+    }
+
+    /// The eight grid vertices of cell `(i, j, k)` in VTK order.
+    pub fn corners(i: usize, j: usize, k: usize) -> [(usize, usize, usize); 8] {
+        [
+            (i, j, k),
+            (i + 1, j, k),
+            (i + 1, j + 1, k),
+            (i, j + 1, k),
+            (i, j, k + 1),
+            (i + 1, j, k + 1),
+            (i + 1, j + 1, k + 1),
+            (i, j + 1, k + 1),
+        ]
+    }
+}
+
+/// The box, its `2^K` grid and the cells kept after culling and dilation.
+pub(super) fn box_cells(points: &[Point3], params: &BoxLatticeParams) -> Result<BoxCells> {
     if params.octree_levels > 7 {
         return Err(Error::Input(format!(
             "{} octree levels requested; at most 7 (128³ cells) are allowed",
@@ -129,24 +174,26 @@ pub fn box_lattice(points: &[Point3], params: &BoxLatticeParams) -> Result<Latti
     }
     let (origin, axes) = bounding_frame(points, params.kind, params.margin)?;
     let n = 1usize << params.octree_levels;
-    let cell_id = |i: usize, j: usize, k: usize| i + n * (j + n * k);
-    let mut keep = vec![!(params.cull && n > 1); n * n * n];
+    let mut cells = BoxCells {
+        origin,
+        axes,
+        n,
+        keep: vec![!(params.cull && n > 1); n * n * n],
+    };
     if params.cull && n > 1 {
-        let m = Matrix3::from_columns(&axes);
-        let inv = m
-            .try_inverse()
-            .ok_or_else(|| Error::Input("the bounding box is degenerate".into()))?;
         let mut occupied = vec![false; n * n * n];
         for p in points {
-            let t = inv * (p - origin);
-            let ijk = [0, 1, 2].map(|k| ((t[k] * n as Real).floor().max(0.0) as usize).min(n - 1));
-            occupied[cell_id(ijk[0], ijk[1], ijk[2])] = true;
+            let t = cells
+                .grid_coords(p)
+                .ok_or_else(|| Error::Input("the bounding box is degenerate".into()))?;
+            let ijk = [0, 1, 2].map(|k| (t[k].floor().max(0.0) as usize).min(n - 1));
+            occupied[cells.cell_id(ijk[0], ijk[1], ijk[2])] = true;
         }
         let r = params.dilate as i64;
         for k in 0..n {
             for j in 0..n {
                 for i in 0..n {
-                    if !occupied[cell_id(i, j, k)] {
+                    if !occupied[cells.cell_id(i, j, k)] {
                         continue;
                     }
                     for dk in -r..=r {
@@ -155,7 +202,8 @@ pub fn box_lattice(points: &[Point3], params: &BoxLatticeParams) -> Result<Latti
                                 let (a, b, c) = (i as i64 + di, j as i64 + dj, k as i64 + dk);
                                 let inside = |x: i64| (0..n as i64).contains(&x);
                                 if inside(a) && inside(b) && inside(c) {
-                                    keep[cell_id(a as usize, b as usize, c as usize)] = true;
+                                    let id = cells.cell_id(a as usize, b as usize, c as usize);
+                                    cells.keep[id] = true;
                                 }
                             }
                         }
@@ -164,6 +212,16 @@ pub fn box_lattice(points: &[Point3], params: &BoxLatticeParams) -> Result<Latti
             }
         }
     }
+    Ok(cells)
+}
+
+/// The kept cells as hexahedra: grid-vertex positions from `position`, and
+/// the new index of every used grid vertex (`u32::MAX` when unused).
+pub(super) fn kept_hexahedra(
+    cells: &BoxCells,
+    mut position: impl FnMut(usize, usize, usize) -> Point3,
+) -> (Vec<Point3>, Vec<[u32; 8]>, Vec<u32>) {
+    let n = cells.n;
     let vid = |i: usize, j: usize, k: usize| i + (n + 1) * (j + (n + 1) * k);
     let mut new_id = vec![u32::MAX; (n + 1) * (n + 1) * (n + 1)];
     let mut positions = Vec::new();
@@ -171,25 +229,14 @@ pub fn box_lattice(points: &[Point3], params: &BoxLatticeParams) -> Result<Latti
     for k in 0..n {
         for j in 0..n {
             for i in 0..n {
-                if !keep[cell_id(i, j, k)] {
+                if !cells.keep[cells.cell_id(i, j, k)] {
                     continue;
                 }
-                let corners = [
-                    (i, j, k),
-                    (i + 1, j, k),
-                    (i + 1, j + 1, k),
-                    (i, j + 1, k),
-                    (i, j, k + 1),
-                    (i + 1, j, k + 1),
-                    (i + 1, j + 1, k + 1),
-                    (i, j + 1, k + 1),
-                ];
-                let h = corners.map(|(a, b, c)| {
+                let h = BoxCells::corners(i, j, k).map(|(a, b, c)| {
                     let v = vid(a, b, c);
                     if new_id[v] == u32::MAX {
                         new_id[v] = positions.len() as u32;
-                        let t = Vector3::new(a as Real, b as Real, c as Real) / n as Real;
-                        positions.push(origin + axes[0] * t.x + axes[1] * t.y + axes[2] * t.z);
+                        positions.push(position(a, b, c));
                     }
                     new_id[v]
                 });
@@ -197,5 +244,15 @@ pub fn box_lattice(points: &[Point3], params: &BoxLatticeParams) -> Result<Latti
             }
         }
     }
+    (positions, hexes, new_id)
+}
+
+/// A lattice around `points`: the bounding box split into `2^K` cells per
+/// axis, empty cells culled (then dilated), as a hexahedral lattice.
+pub fn box_lattice(points: &[Point3], params: &BoxLatticeParams) -> Result<Lattice> {
+    let cells = box_cells(points, params)?;
+    let (positions, hexes, _) = kept_hexahedra(&cells, |a, b, c| {
+        cells.position(Vector3::new(a as Real, b as Real, c as Real))
+    });
     hexahedra(positions, &hexes)
 }

@@ -94,8 +94,11 @@ impl LatticeHierarchy {
                 self.depth()
             )));
         }
-        let mut s = StencilTable::identity(self.levels[0].topology.num_vertices);
-        for t in &self.stencils[..k] {
+        let Some((first, rest)) = self.stencils[..k].split_first() else {
+            return Ok(StencilTable::identity(self.levels[0].topology.num_vertices));
+        };
+        let mut s = first.clone();
+        for t in rest {
             s = t.compose(&s)?;
         }
         Ok(s)

@@ -23,14 +23,20 @@ mod builders;
 mod hierarchy;
 #[allow(clippy::module_inception)]
 mod lattice;
+mod local_refine;
+mod octree;
 mod refine_topology;
 mod rules;
+mod shrink;
 mod topology;
 
 pub use box_lattice::{BoxKind, BoxLatticeParams, bounding_frame, box_lattice};
 pub use builders::{HEX_FACES, LatticeBuilder, box_grid, cylinder, extrude, hexahedra};
 pub use hierarchy::{LatticeHierarchy, LatticeLevel, MAX_LATTICE_LEVELS};
 pub use lattice::{BoundaryTags, Lattice, cell_volume, check_geometry};
-pub use refine_topology::{TypeNCells, refined_topology};
+pub use local_refine::{LocalRefineReport, locally_refined};
+pub use octree::{octree_refined, octree_stencil};
+pub use refine_topology::{TypeNCells, refined_cells, refined_topology};
 pub use rules::{refined_tags, refinement_stencil};
+pub use shrink::{ShrinkReport, shrunk_box_lattice};
 pub use topology::{Csr, LatticeTopology, NO_CELL};

@@ -76,6 +76,37 @@ impl TypeNCells {
 /// The refined topology and its type-n cells; child cells are numbered by
 /// parent cell, then by the parent's vertices in `cell_vertices` order.
 pub fn refined_topology(topo: &LatticeTopology) -> Result<(LatticeTopology, TypeNCells)> {
+    let parts = refined_parts(topo)?;
+    let child = LatticeTopology::new(parts.num_vertices, &parts.faces, &parts.cells)?;
+    Ok((child, parts.type_n))
+}
+
+/// The refined level's cells as type-n cells and its boundary faces (the
+/// children of the parent's boundary faces), without building the full
+/// incidence structure of [`refined_topology`]: the type-n cells describe
+/// every cell completely (their faces follow from apex, centre and ring),
+/// which is all an embedding needs, in a fraction of the memory.
+pub fn refined_cells(topo: &LatticeTopology) -> Result<(TypeNCells, Vec<[u32; 4]>)> {
+    let parts = refined_parts(topo)?;
+    let mut boundary = Vec::new();
+    for f in topo.boundary_faces() {
+        let (a, b) = (
+            topo.faces.offsets[f as usize] as usize,
+            topo.faces.offsets[f as usize + 1] as usize,
+        );
+        boundary.extend_from_slice(&parts.faces[a..b]);
+    }
+    Ok((parts.type_n, boundary))
+}
+
+struct RefinedParts {
+    num_vertices: usize,
+    faces: Vec<[u32; 4]>,
+    cells: Vec<Vec<u32>>,
+    type_n: TypeNCells,
+}
+
+fn refined_parts(topo: &LatticeTopology) -> Result<RefinedParts> {
     let nv = topo.num_vertices as u32;
     let ne = topo.num_edges() as u32;
     let nf = topo.num_faces() as u32;
@@ -134,14 +165,14 @@ pub fn refined_topology(topo: &LatticeTopology) -> Result<(LatticeTopology, Type
             rings.push(vring);
         }
     }
-    let num_vertices = (nv + ne + nf) as usize + topo.num_cells();
-    let child = LatticeTopology::new(num_vertices, &faces, &cells)?;
-    Ok((
-        child,
-        TypeNCells {
+    Ok(RefinedParts {
+        num_vertices: (nv + ne + nf) as usize + topo.num_cells(),
+        faces,
+        cells,
+        type_n: TypeNCells {
             apex,
             centre,
             ring: Csr::from_lists(&rings),
         },
-    ))
+    })
 }

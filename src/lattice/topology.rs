@@ -107,6 +107,48 @@ pub struct LatticeTopology {
     pub vertex_edges: Csr,
 }
 
+/// A multiplicative hasher for the integer and short-slice keys of
+/// [`LatticeTopology::new`] (the standard SipHash dominated its run time;
+/// the keys come from the lattice's own indices, so no flooding defence is
+/// needed).
+#[derive(Clone, Copy, Default)]
+struct FastHash;
+
+struct FastHasher(u64);
+
+impl std::hash::BuildHasher for FastHash {
+    type Hasher = FastHasher;
+    fn build_hasher(&self) -> FastHasher {
+        FastHasher(0)
+    }
+}
+
+impl std::hash::Hasher for FastHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        let mut chunks = bytes.chunks_exact(8);
+        for c in &mut chunks {
+            let mut w = [0u8; 8];
+            w.copy_from_slice(c);
+            self.write_u64(u64::from_le_bytes(w));
+        }
+        for &b in chunks.remainder() {
+            self.write_u64(b as u64);
+        }
+    }
+    fn write_u32(&mut self, x: u32) {
+        self.write_u64(x as u64);
+    }
+    fn write_usize(&mut self, x: usize) {
+        self.write_u64(x as u64);
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x51_7C_C1_B7_27_22_0A_95);
+    }
+}
+
 fn edge_key(a: u32, b: u32) -> u64 {
     let (a, b) = if a < b { (a, b) } else { (b, a) };
     ((a as u64) << 32) | b as u64
@@ -127,28 +169,35 @@ impl LatticeTopology {
         if cells.is_empty() {
             return Err(Error::Topology("the lattice has no cell".into()));
         }
-        let mut seen_faces: HashMap<Vec<u32>, usize> = HashMap::new();
+        // Repeated faces: sorted vertex sets in one flat buffer, hashed as
+        // slices (no allocation per face).
+        let mut keys = Csr::from_lists(faces);
         for (f, loop_) in faces.iter().enumerate() {
-            let l = loop_.as_ref();
+            let (a, b) = (keys.offsets[f] as usize, keys.offsets[f + 1] as usize);
+            let l = &mut keys.items[a..b];
             if let Some(&v) = l.iter().find(|&&v| v as usize >= num_vertices) {
                 return Err(Error::Topology(format!(
                     "face {f}: vertex {v} out of range (the lattice has {num_vertices} vertices)"
                 )));
             }
-            let mut key = l.to_vec();
-            key.sort_unstable();
-            key.dedup();
-            if key.len() < 3 || key.len() != l.len() {
+            l.sort_unstable();
+            if l.len() < 3 || l.windows(2).any(|w| w[0] == w[1]) {
                 return Err(Error::Topology(format!(
-                    "face {f}: needs at least three distinct vertices, got {l:?}"
+                    "face {f}: needs at least three distinct vertices, got {:?}",
+                    loop_.as_ref()
                 )));
             }
-            if let Some(g) = seen_faces.insert(key, f) {
+        }
+        let mut seen_faces: HashMap<&[u32], usize, FastHash> =
+            HashMap::with_capacity_and_hasher(keys.len(), FastHash);
+        for f in 0..keys.len() {
+            if let Some(g) = seen_faces.insert(keys.row(f), f) {
                 return Err(Error::Topology(format!(
                     "face {f} repeats face {g} (same vertices)"
                 )));
             }
         }
+        drop(seen_faces);
         let faces = Csr::from_lists(faces);
         let cells = Csr::from_lists(cells);
         let nf = faces.len();
@@ -184,7 +233,8 @@ impl LatticeTopology {
             return Err(Error::Topology(format!("face {f}: belongs to no cell")));
         }
         // Edges.
-        let mut edge_ids: HashMap<u64, u32> = HashMap::new();
+        let mut edge_ids: HashMap<u64, u32, FastHash> =
+            HashMap::with_capacity_and_hasher(faces.items.len() / 2, FastHash);
         let mut edges = Vec::new();
         let mut fe = Vec::with_capacity(faces.items.len());
         for f in 0..nf {
@@ -208,46 +258,70 @@ impl LatticeTopology {
             (0..nf).flat_map(|f| face_edges.row(f).iter().map(move |&e| (e, f as u32))),
         );
         // Cell closure: each edge of a cell in exactly two of its faces.
-        let mut cell_vertex_lists = Vec::with_capacity(cells.len());
-        let mut count: HashMap<u32, u32> = HashMap::new();
+        let mut cell_vertices = Csr {
+            offsets: Vec::with_capacity(cells.len() + 1),
+            items: Vec::with_capacity(8 * cells.len()),
+        };
+        cell_vertices.offsets.push(0);
+        let mut cell_edges: Vec<u32> = Vec::new();
         for c in 0..cells.len() {
-            count.clear();
-            let mut verts = Vec::new();
+            cell_edges.clear();
+            let start = cell_vertices.items.len();
             for &f in cells.row(c) {
-                for &e in face_edges.row(f as usize) {
-                    *count.entry(e).or_insert(0) += 1;
+                cell_edges.extend_from_slice(face_edges.row(f as usize));
+                cell_vertices.items.extend_from_slice(faces.row(f as usize));
+            }
+            cell_edges.sort_unstable();
+            let mut distinct = 0;
+            let mut i = 0;
+            while i < cell_edges.len() {
+                let e = cell_edges[i];
+                let k = cell_edges[i..].iter().take_while(|&&x| x == e).count();
+                if k != 2 {
+                    let [a, b] = edges[e as usize];
+                    return Err(Error::Topology(format!(
+                        "cell {c}: not closed — edge {a}-{b} is in {k} of its faces (expected 2)"
+                    )));
                 }
-                verts.extend_from_slice(faces.row(f as usize));
+                distinct += 1;
+                i += k;
             }
-            if let Some((&e, &k)) = count.iter().find(|(_, k)| **k != 2) {
-                let [a, b] = edges[e as usize];
-                return Err(Error::Topology(format!(
-                    "cell {c}: not closed — edge {a}-{b} is in {k} of its faces (expected 2)"
-                )));
-            }
+            let verts = &mut cell_vertices.items[start..];
             verts.sort_unstable();
-            verts.dedup();
-            let euler = verts.len() as i64 - count.len() as i64 + cells.row(c).len() as i64;
+            let mut n = 0;
+            for j in 0..verts.len() {
+                if j == 0 || verts[j] != verts[n - 1] {
+                    verts[n] = verts[j];
+                    n += 1;
+                }
+            }
+            cell_vertices.items.truncate(start + n);
+            let euler = n as i64 - distinct as i64 + cells.row(c).len() as i64;
             if euler != 2 {
                 return Err(Error::Topology(format!(
                     "cell {c}: its faces do not bound a ball (V - E + F = {euler}, expected 2)"
                 )));
             }
-            cell_vertex_lists.push(verts);
+            cell_vertices.offsets.push(cell_vertices.items.len() as u32);
         }
-        let cell_vertices = Csr::from_lists(&cell_vertex_lists);
         let edge_cells = {
-            let mut lists: Vec<Vec<u32>> = vec![Vec::new(); ne];
-            for (e, list) in lists.iter_mut().enumerate() {
+            let mut csr = Csr {
+                offsets: Vec::with_capacity(ne + 1),
+                items: Vec::with_capacity(edge_faces.items.len()),
+            };
+            csr.offsets.push(0);
+            for e in 0..ne {
+                let start = csr.items.len();
                 for &f in edge_faces.row(e) {
                     for &c in &face_cells[f as usize] {
-                        if c != NO_CELL && !list.contains(&c) {
-                            list.push(c);
+                        if c != NO_CELL && !csr.items[start..].contains(&c) {
+                            csr.items.push(c);
                         }
                     }
                 }
+                csr.offsets.push(csr.items.len() as u32);
             }
-            Csr::from_lists(&lists)
+            csr
         };
         let nc = cells.len();
         let vertex_cells = Csr::from_pairs(
@@ -362,7 +436,8 @@ impl LatticeTopology {
     /// The faces of cell `c` around its vertex `v` in cyclic order, as the
     /// ring `[e_1, f_1, e_2, f_2, …, e_n, f_n]` where face `f_i` holds edges
     /// `e_i` and `e_{i+1}` (indices into edges and faces). `n` is the valence
-    /// of `v` in `c` (MacCracken & Joy 1996, §2.2).
+    /// of `v` in `c` (MacCracken & Joy 1996, §2.2); `n = 2` happens at an
+    /// edge point that local refinement inserted into a neighbour's edge.
     pub fn corner_ring(&self, c: usize, v: u32) -> Result<Vec<u32>> {
         let cell_faces = self.cells.row(c);
         // (face, edge-in, edge-out) for the faces of c at v.
@@ -381,7 +456,7 @@ impl LatticeTopology {
                 "cell {c}: its faces at vertex {v} do not form one fan (the cell is pinched there)"
             ))
         };
-        if n < 3 {
+        if n < 2 {
             return Err(bad());
         }
         let mut ring = Vec::with_capacity(2 * n);
