@@ -39,6 +39,7 @@ pub mod math;
 pub mod mesh;
 pub mod metrics;
 pub mod render;
+pub mod solid;
 pub mod stencil;
 pub mod subdivision;
 pub mod topology;
