@@ -6,6 +6,8 @@ use subdyn::lattice::{Lattice, box_grid};
 use subdyn::math::{Point3, Real, Vector3};
 use subdyn::solid::{Solid, SolidParams, Stiffness, extrude_face, trim_cell};
 
+mod common;
+
 fn cube() -> Lattice {
     box_grid(
         Point3::new(0.0, 0.0, 0.0),
@@ -336,4 +338,164 @@ fn bad_input_is_an_error() {
         }
     }
     assert!(failed);
+}
+
+fn write_cube_json(dir: &std::path::Path) -> std::path::PathBuf {
+    let path = dir.join("cube.json");
+    subdyn::io::write_lattice(&path, &cube()).unwrap();
+    path
+}
+
+#[test]
+fn sculpt_cli_runs_a_script_and_writes_frames_and_a_log() {
+    let dir = tempfile::tempdir().unwrap();
+    write_cube_json(dir.path());
+    let script = r#"{"dt": 0.005, "steps": 40, "ops": [
+        {"step": 0, "op": "fix", "box": [[-1, -1, -1], [2, 0.01, 2]]},
+        {"step": 0, "op": "rope", "at": [1, 1, 1], "to": [1.3, 1.3, 1.3], "until": 20},
+        {"step": 20, "op": "extrude", "near": [0.75, 1, 0.75]},
+        {"step": 30, "op": "trim", "cell": 8},
+        {"step": 35, "op": "release"},
+        {"step": 35, "op": "plastic"}]}"#;
+    std::fs::write(dir.path().join("ops.json"), script).unwrap();
+    for integrator in ["explicit", "implicit"] {
+        let out = common::run_subdyn(
+            dir.path(),
+            &[
+                "sculpt",
+                "cube.json",
+                "--level",
+                "1",
+                "--script",
+                "ops.json",
+                "--out-dir",
+                "out",
+                "--every",
+                "10",
+                "--integrator",
+                integrator,
+            ],
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let log: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.path().join("out/log.json")).unwrap(),
+        )
+        .unwrap();
+        let frames = log["frames"].as_array().unwrap();
+        assert_eq!(frames.len(), 5);
+        assert!(
+            frames[2]["rope"].as_f64().unwrap() > 0.0 || frames[1]["rope"].as_f64().unwrap() > 0.0
+        );
+        assert_eq!(
+            frames[2]["mass_points"].as_u64(),
+            Some(143),
+            "extruded at level 1: 125 + 4 vertex, 8 edge, 5 face and 1 cell points"
+        );
+        assert_eq!(frames[4]["mass_points"].as_u64(), Some(125), "trimmed back");
+        assert_eq!(log["ops"].as_array().unwrap().len(), 6);
+        let obj = subdyn::io::read_mesh(dir.path().join("out/frame_0000040.obj")).unwrap();
+        assert_eq!(obj.num_faces(), 6 * 16);
+        // After make plastic and halt the frames stop changing energy.
+        assert!(frames[4]["kinetic"].as_f64().unwrap() < 1e-20);
+    }
+}
+
+#[test]
+fn sculpt_cli_rejects_bad_scripts_with_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    write_cube_json(dir.path());
+    let bad = [
+        (
+            r#"{"dt": 0.01, "steps": 10, "ops": [{"step": 1, "op": "spin"}]}"#,
+            "op 0",
+        ),
+        (r#"{"dt": -1, "steps": 10}"#, "dt"),
+        (r#"{"dt": 0.01, "steps": 0}"#, "steps"),
+        (
+            r#"{"dt": 0.01, "steps": 10, "ops": [{"step": 11, "op": "release"}]}"#,
+            "after the last step",
+        ),
+        (
+            r#"{"dt": 0.01, "steps": 10, "ops": [{"op": "release"}]}"#,
+            "step",
+        ),
+        (
+            r#"{"dt": 0.01, "steps": 10, "ops": [{"step": 1, "op": "extrude", "face": 99}]}"#,
+            "not a boundary face",
+        ),
+        (
+            r#"{"dt": 0.01, "steps": 10, "ops": [{"step": 1, "op": "extrude"}]}"#,
+            "exactly one",
+        ),
+        (
+            r#"{"dt": 0.01, "steps": 10, "ops": [{"step": 1, "op": "fix", "box": [[5, 5, 5], [6, 6, 6]]}]}"#,
+            "no control point",
+        ),
+        (
+            r#"{"dt": 2.0, "steps": 200, "ops": [{"step": 0, "op": "rope", "at": [1, 1, 1], "to": [9, 9, 9], "stiffness": 1000}]}"#,
+            "smaller dt",
+        ),
+        (r#"{"dt": 0.01, "steps": 10"#, "not a valid sculpt script"),
+    ];
+    for (i, (script, expect)) in bad.iter().enumerate() {
+        std::fs::write(dir.path().join("bad.json"), script).unwrap();
+        let out = common::run_subdyn(
+            dir.path(),
+            &[
+                "sculpt",
+                "cube.json",
+                "--level",
+                "1",
+                "--script",
+                "bad.json",
+                "--out-dir",
+                "bad",
+            ],
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "script {i}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "script {i}: {err}");
+        assert!(
+            err.contains(expect),
+            "script {i}: expected {expect:?} in {err}"
+        );
+    }
+    let out = common::run_subdyn(
+        dir.path(),
+        &[
+            "sculpt",
+            "cube.json",
+            "--level",
+            "9",
+            "--script",
+            "bad.json",
+            "--out-dir",
+            "bad",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    std::fs::write(
+        dir.path().join("broken.json"),
+        "{\"vertices\": [[0, 0, 0]], \"hexahedra\": [[0, 0, 0, 0, 0, 0, 0, 0]]}",
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("ok.json"), r#"{"dt": 0.01, "steps": 1}"#).unwrap();
+    let out = common::run_subdyn(
+        dir.path(),
+        &[
+            "sculpt",
+            "broken.json",
+            "--script",
+            "ok.json",
+            "--out-dir",
+            "bad",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("broken.json"), "{err}");
 }

@@ -21,6 +21,9 @@ mod options;
 mod progress;
 mod recover;
 mod render;
+mod sculpt;
+mod sculpt_demo;
+mod sculpt_script;
 mod subdivide;
 mod subdivide_scheme;
 

@@ -265,7 +265,9 @@ impl Solid {
 
     /// Energy stored in the rope springs.
     pub fn rope_energy(&self) -> Real {
-        self.ropes.iter().map(|r| r.force_energy(&self.d).1).sum()
+        self.ropes
+            .iter()
+            .fold(0.0, |s, r| s + r.force_energy(&self.d).1)
     }
 
     /// Kinetic plus spring energy (ropes excluded: they are external).
