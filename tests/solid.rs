@@ -4,7 +4,9 @@
 
 use subdyn::lattice::{Lattice, box_grid};
 use subdyn::math::{Point3, Real, Vector3};
-use subdyn::solid::{Solid, SolidParams, Stiffness, extrude_face, trim_cell};
+use subdyn::solid::{
+    Solid, SolidParams, SpringHessians, SpringNetwork, Stiffness, extrude_face, trim_cell,
+};
 
 mod common;
 
@@ -74,7 +76,13 @@ fn without_forces_the_solid_stays_at_rest() {
 
 #[test]
 fn momentum_is_conserved_without_damping_and_fixed_points() {
-    let mut s = solid(2, 0.0);
+    let params = SolidParams {
+        level: 2,
+        damping: 0.0,
+        cg_tolerance: 1e-10,
+        ..SolidParams::default()
+    };
+    let mut s = Solid::new(&cube(), params).unwrap();
     perturb(&mut s, 0.2);
     let m0 = s.momentum();
     assert!(m0.norm() > 1e-2, "the test needs a moving solid");
@@ -90,7 +98,7 @@ fn momentum_is_conserved_without_damping_and_fixed_points() {
     for _ in 0..20 {
         s.step_implicit(1e-2).unwrap();
     }
-    // CG stops at a relative residual of 1e-8.
+    // CG stops at a relative residual of 1e-10.
     assert!(
         (s.momentum() - m0).norm() < 1e-6 * m0.norm(),
         "{:?} vs {m0:?}",
@@ -498,4 +506,76 @@ fn sculpt_cli_rejects_bad_scripts_with_one_line() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("broken.json"), "{err}");
+}
+
+#[test]
+fn spring_hessian_is_the_derivative_of_the_spring_forces() {
+    // A stretched, sheared level-1 cube: every spring longer than at rest, so
+    // no transverse term is clamped and K must equal −∂f/∂x exactly.
+    let lat = cube();
+    let h = subdyn::lattice::LatticeHierarchy::new(&lat, 1).unwrap();
+    let topo = &h.level(1).topology;
+    let rest = h
+        .stencil_to_level(1)
+        .unwrap()
+        .apply(&lat.positions)
+        .unwrap();
+    let net = SpringNetwork::new(topo, &rest).unwrap();
+    assert_eq!(net.len(), 300 + 4 * 240);
+    let x: Vec<Point3> = rest
+        .iter()
+        .map(|p| Point3::new(1.2 * p.x + 0.1 * p.y, 1.15 * p.y, 1.25 * p.z + 0.05 * p.x))
+        .collect();
+    let k = Stiffness {
+        edge: 3.0,
+        virtual_: 2.0,
+    };
+    let w: Vec<Vector3> = (0..x.len())
+        .map(|i| {
+            let t = i as Real;
+            Vector3::new((0.7 * t).sin(), (1.3 * t).cos(), (0.4 * t + 1.0).sin())
+        })
+        .collect();
+    let mut hess = SpringHessians::default();
+    net.hessians_into(&x, k, &mut hess);
+    let mut kw = vec![Vector3::zeros(); x.len()];
+    net.add_hessian_product(&hess, &w, &mut kw);
+    let eps = 1e-6;
+    let force = |sign: Real| {
+        let y: Vec<Point3> = x
+            .iter()
+            .zip(&w)
+            .map(|(p, v)| p + v * (sign * eps))
+            .collect();
+        let mut f = vec![Vector3::zeros(); x.len()];
+        net.add_forces(&y, k, &mut f);
+        f
+    };
+    let (fp, fm) = (force(1.0), force(-1.0));
+    let scale = kw.iter().map(|v| v.norm()).fold(0.0, Real::max);
+    assert!(scale > 1e-2);
+    for i in 0..x.len() {
+        let fd = -(fp[i] - fm[i]) / (2.0 * eps);
+        assert!(
+            (fd - kw[i]).norm() < 1e-6 * scale,
+            "point {i}: {fd:?} vs {:?}",
+            kw[i]
+        );
+    }
+    // Forces sum to zero (momentum) and energy is positive away from rest.
+    let mut f = vec![Vector3::zeros(); x.len()];
+    let e = net.add_forces(&x, k, &mut f);
+    assert!(e > 0.0 && (e - net.energy(&x, k)).abs() < 1e-12 * e);
+    assert!(f.iter().sum::<Vector3>().norm() < 1e-12 * scale);
+}
+
+#[test]
+fn bench_sculpt_rejects_absurd_arguments() {
+    let dir = tempfile::tempdir().unwrap();
+    for args in [["--steps", "0"], ["--dt", "NaN"], ["--dt", "5"]] {
+        let out = common::run_subdyn(dir.path(), &["bench", "sculpt", args[0], args[1]]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+    }
 }

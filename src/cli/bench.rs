@@ -44,6 +44,9 @@ pub enum BenchCommand {
     /// Recovering a torus from a synthetic N³ volume, stage by stage, with
     /// peak memory; the last stdout line is one JSON object.
     Recover(super::bench_recover::BenchRecoverArgs),
+    /// Time steps of dynamic subdivision solids on the models of McDonnell &
+    /// Qin's Table 1, explicit and implicit; one JSON object per row.
+    Sculpt(super::bench_sculpt::BenchSculptArgs),
 }
 
 /// Arguments of `subdyn bench subdivide`.
@@ -84,6 +87,7 @@ pub fn run(cmd: &BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Closest(args) => super::bench_closest::bench_closest(args),
         BenchCommand::Distance(args) => super::bench_distance::bench_distance(args),
         BenchCommand::Recover(args) => super::bench_recover::bench_recover(args),
+        BenchCommand::Sculpt(args) => super::bench_sculpt::bench_sculpt(args),
     }
 }
 

@@ -5,6 +5,7 @@ mod bench;
 mod bench_closest;
 mod bench_distance;
 mod bench_recover;
+mod bench_sculpt;
 mod common;
 mod compare;
 mod ffd;

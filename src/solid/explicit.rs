@@ -11,7 +11,7 @@ use crate::math::Real;
 
 use super::model::Solid;
 use super::params::{ExplicitScheme, check_value};
-use super::products::{mul_vectors_new, solve_vectors};
+use super::products::{mul_transpose_vectors, solve_vectors};
 
 /// What one time step did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -50,7 +50,7 @@ impl Solid {
         let start = Instant::now();
         let (f, spring_energy) = self.mass_point_forces();
         if let Some(factor) = &self.part.mass_factor {
-            let g = mul_vectors_new(&self.part.a1t, &f);
+            let g = mul_transpose_vectors(&self.part.a1, &f);
             let acc = solve_vectors(factor, &g);
             for (k, &i) in self.part.free.iter().enumerate() {
                 let old = self.v[i];

@@ -8,8 +8,9 @@
 //! `M̂ = A₁ᵀ M A₁`, `D̂ = γ M̂`, `K̂ = A₁ᵀ K A₁`, `K` the springs' and ropes'
 //! Hessian at `d` (transverse terms clamped, so the matrix is SPD), `f` the
 //! mass-point forces of [`Solid::step_explicit`]; then `ṗ₁ += Δṗ₁`,
-//! `p₁ += h ṗ₁`. CG runs matrix-free (one `A₁`, one Hessian and one `A₁ᵀ`
-//! product per iteration) with the preconditioner
+//! `p₁ += h ṗ₁`. CG starts from the previous step's `Δṗ₁` and runs matrix-free
+//! (one `A₁`, one Hessian and one `A₁ᵀ` product per iteration; the spring
+//! Hessians are computed once per step) with the preconditioner
 //! `P = (1 + hγ) M̂ + h² A₁ᵀ L A₁`, `L = Σ k_s b_s b_sᵀ` the isotropic spring
 //! Laplacian (the rest-state Hessian with every spring direction replaced by
 //! the identity), factored once per time step, material and partition.
@@ -22,7 +23,8 @@ use crate::stencil::StencilTable;
 
 use super::explicit::{StepReport, check_step};
 use super::model::{Preconditioner, Solid};
-use super::products::{cholesky, dot, mul_vectors, mul_vectors_new, solve_vectors};
+use super::products::{cholesky, dot, mul_transpose_vectors, mul_vectors, solve_vectors};
+use super::springs::SpringHessians;
 
 impl Solid {
     /// The preconditioner for step `h`, built if the cache does not hold it.
@@ -48,10 +50,9 @@ impl Solid {
     }
 
     /// `K w` of the springs and ropes at the current mass points.
-    fn stiffness_product(&self, w: &[Vector3], out: &mut [Vector3]) {
+    fn stiffness_product(&self, hess: &SpringHessians, w: &[Vector3], out: &mut [Vector3]) {
         out.iter_mut().for_each(|o| *o = Vector3::zeros());
-        self.springs
-            .add_hessian_product(&self.d, self.params.stiffness, w, out);
+        self.springs.add_hessian_product(hess, w, out);
         for r in &self.ropes {
             out[r.point] += r.hessian_times(&self.d, w[r.point]);
         }
@@ -76,29 +77,44 @@ impl Solid {
         let scale = 1.0 + h * self.params.damping;
         let mut kw = vec![Vector3::zeros(); nd];
         // b = h A₁ᵀ (f − h K ḋ)
-        self.stiffness_product(&self.dd, &mut kw);
+        let mut hess = std::mem::take(&mut self.hess);
+        self.springs
+            .hessians_into(&self.d, self.params.stiffness, &mut hess);
+        self.stiffness_product(&hess, &self.dd, &mut kw);
         let rhs_fine: Vec<Vector3> = f.iter().zip(&kw).map(|(f, k)| (f - k * h) * h).collect();
-        let b = mul_vectors_new(&self.part.a1t, &rhs_fine);
+        let b = mul_transpose_vectors(&self.part.a1, &rhs_fine);
         let mut w = vec![Vector3::zeros(); nd];
         let mut fine = vec![Vector3::zeros(); nd];
         let mut apply = |x: &[Vector3]| -> Vec<Vector3> {
             mul_vectors(&self.part.a1, x, &mut w);
-            self.stiffness_product(&w, &mut kw);
+            self.stiffness_product(&hess, &w, &mut kw);
             for i in 0..nd {
                 fine[i] = w[i] * (scale * self.mass[i]) + kw[i] * (h * h);
             }
-            mul_vectors_new(&self.part.a1t, &fine)
+            mul_transpose_vectors(&self.part.a1, &fine)
         };
-        // Preconditioned CG from x = 0.
+        // Preconditioned CG, warm-started from the previous step's Δṗ₁.
         let n = free.len();
-        let mut x = vec![Vector3::zeros(); n];
+        let mut x = if self.last_dv.len() == n {
+            self.last_dv.clone()
+        } else {
+            vec![Vector3::zeros(); n]
+        };
         let b_norm = dot(&b, &b).sqrt();
-        let mut r = b.clone();
+        let ax = apply(&x);
+        let mut r: Vec<Vector3> = b.iter().zip(&ax).map(|(b, a)| b - a).collect();
         let mut z = solve_vectors(&pre.factor, &r);
         let mut dir = z.clone();
         let mut rz = dot(&r, &z);
         let mut iterations = 0;
-        let mut residual = if b_norm > 0.0 { 1.0 } else { 0.0 };
+        let mut residual = if b_norm > 0.0 {
+            dot(&r, &r).sqrt() / b_norm
+        } else {
+            0.0
+        };
+        if b_norm == 0.0 {
+            x.iter_mut().for_each(|v| *v = Vector3::zeros());
+        }
         let tol = self.params.cg_tolerance;
         while residual > tol && iterations < self.params.cg_max_iterations {
             let q = apply(&dir);
@@ -127,6 +143,8 @@ impl Solid {
             self.v[i] += x[k];
             self.p[i] += self.v[i] * h;
         }
+        self.last_dv = x;
+        self.hess = hess;
         self.refresh();
         self.time += h;
         Ok(StepReport {

@@ -38,5 +38,5 @@ pub use edit::{extrude_face, extruded_topology, extrusion_offset, trim_cell, tri
 pub use explicit::StepReport;
 pub use model::{MAX_SOLID_LEVEL, Solid, lumped_masses};
 pub use params::{ExplicitScheme, SolidParams};
-pub use springs::{SpringNetwork, Stiffness};
+pub use springs::{SpringHessians, SpringNetwork, Stiffness};
 pub use tools::Rope;

@@ -74,6 +74,10 @@ pub struct Solid {
     pub(crate) d: Vec<Point3>,
     pub(crate) dd: Vec<Vector3>,
     pub(crate) precond: Option<Preconditioner>,
+    /// The implicit step's last `Δṗ₁` (its CG's next initial guess).
+    pub(crate) last_dv: Vec<Vector3>,
+    /// Buffers of the implicit step's spring Hessians.
+    pub(crate) hess: super::springs::SpringHessians,
     pub(crate) time: Real,
 }
 
@@ -121,6 +125,8 @@ impl Solid {
             d: Vec::new(),
             dd: Vec::new(),
             precond: None,
+            last_dv: Vec::new(),
+            hess: Default::default(),
             time: 0.0,
         };
         solid.rebuild_all()?;
@@ -167,6 +173,7 @@ impl Solid {
             mass_factor,
         };
         self.precond = None;
+        self.last_dv.clear();
         self.refresh();
         Ok(())
     }

@@ -52,7 +52,7 @@ impl Default for SolidParams {
             },
             damping: 2.0,
             scheme: ExplicitScheme::SymplecticEuler,
-            cg_tolerance: 1e-8,
+            cg_tolerance: 1e-6,
             cg_max_iterations: 500,
         }
     }

@@ -24,10 +24,42 @@ pub fn mul_vectors(t: &StencilTable, x: &[Vector3], out: &mut [Vector3]) {
         });
 }
 
-/// `T x` as a new vector.
-pub fn mul_vectors_new(t: &StencilTable, x: &[Vector3]) -> Vec<Vector3> {
-    let mut out = vec![Vector3::zeros(); t.num_rows()];
-    mul_vectors(t, x, &mut out);
+/// `Tᵀ f` for a table `T` with few columns (`A₁ᵀ f`: forces on mass points
+/// to forces on control points), rows split over the workers, each
+/// accumulating into its own small buffer.
+pub fn mul_transpose_vectors(t: &StencilTable, f: &[Vector3]) -> Vec<Vector3> {
+    debug_assert_eq!(f.len(), t.num_rows());
+    let n = t.num_cols;
+    let rows = t.num_rows();
+    let parts = rayon::current_num_threads()
+        .clamp(1, 8)
+        .min(rows.div_ceil(1024).max(1));
+    let size = rows.div_ceil(parts);
+    let partial: Vec<Vec<Vector3>> = (0..parts)
+        .into_par_iter()
+        .map(|p| {
+            let mut acc = vec![Vector3::zeros(); n];
+            let r0 = p * size;
+            for (r, &fr) in f
+                .iter()
+                .enumerate()
+                .take(((p + 1) * size).min(rows))
+                .skip(r0)
+            {
+                let (c, w) = t.row(r);
+                for (&c, &w) in c.iter().zip(w) {
+                    acc[c as usize] += w * fr;
+                }
+            }
+            acc
+        })
+        .collect();
+    let mut out = vec![Vector3::zeros(); n];
+    for acc in partial {
+        for (o, a) in out.iter_mut().zip(acc) {
+            *o += a;
+        }
+    }
     out
 }
 

@@ -41,6 +41,9 @@ pub struct SpringNetwork {
     pub virtual_scale: Vec<Real>,
     /// Number of mass points.
     pub num_points: usize,
+    /// The virtual springs of face `f` are `face_offsets[f]..face_offsets[f + 1]`
+    /// (one per corner, in loop order).
+    pub face_offsets: Vec<u32>,
 }
 
 /// Stiffness coefficients `κ` of the two spring types (per unit length).
@@ -70,17 +73,30 @@ fn tension(d: Vector3, rest: Real, k: Real) -> (Vector3, Real) {
     (d * (k * stretch / l), 0.5 * k * stretch * stretch)
 }
 
-/// `H δ` with the spring's Hessian `H = k [u uᵀ + max(0, 1 − L₀/|Δ|) (I − u uᵀ)]`
-/// (the transverse term clamped at zero so that `H` stays positive semi-definite).
-fn hessian_times(d: Vector3, rest: Real, k: Real, delta: Vector3) -> Vector3 {
+/// The spring's Hessian `H = k [u uᵀ + t (I − u uᵀ)]`, `t = max(0, 1 − L₀/|Δ|)`
+/// (the transverse term clamped at zero so that `H` stays positive
+/// semi-definite), stored as `[u_x, u_y, u_z, k, k t]`.
+fn hessian(d: Vector3, rest: Real, k: Real) -> [Real; 5] {
     let l = d.norm();
     if l <= 0.0 {
-        return delta * k;
+        return [0.0, 0.0, 0.0, k, k];
     }
     let u = d / l;
-    let along = u * u.dot(&delta);
-    let t = (1.0 - rest / l).max(0.0);
-    (along + (delta - along) * t) * k
+    [u.x, u.y, u.z, k, k * (1.0 - rest / l).max(0.0)]
+}
+
+/// `H δ` for a Hessian stored by [`hessian`].
+fn hessian_times(h: &[Real; 5], delta: Vector3) -> Vector3 {
+    let u = Vector3::new(h[0], h[1], h[2]);
+    delta * h[4] + u * ((h[3] - h[4]) * u.dot(&delta))
+}
+
+/// The spring Hessians at one configuration, for repeated products (the
+/// implicit integrator's CG iterations).
+#[derive(Clone, Debug, Default)]
+pub struct SpringHessians {
+    edges: Vec<[Real; 5]>,
+    virtuals: Vec<[Real; 5]>,
 }
 
 /// Splits `0..n` into one contiguous range per worker and sums the per-range
@@ -127,6 +143,7 @@ impl SpringNetwork {
         }
         let edges = topo.edges.clone();
         let mut virtuals = Vec::with_capacity(topo.faces.items.len());
+        let face_offsets = topo.faces.offsets.clone();
         for f in 0..topo.num_faces() {
             let l = topo.faces.row(f);
             let k = l.len();
@@ -138,6 +155,7 @@ impl SpringNetwork {
             edges,
             virtuals,
             num_points: topo.num_vertices,
+            face_offsets,
             ..SpringNetwork::default()
         };
         net.set_rest(rest)?;
@@ -249,43 +267,77 @@ impl SpringNetwork {
         e + v
     }
 
-    /// Adds `K w` into `out`, `K = ∂²E/∂x²` linearised at `x` (transverse
-    /// terms clamped to keep it positive semi-definite): the stiffness of the
-    /// implicit integrator.
-    pub fn add_hessian_product(
-        &self,
-        x: &[Point3],
-        k: Stiffness,
-        w: &[Vector3],
-        out: &mut [Vector3],
-    ) {
+    /// The springs' Hessians `∂²E/∂Δ²` at `x` (transverse terms clamped to
+    /// keep them positive semi-definite), written into `h` (its buffers are
+    /// reused): the stiffness `K` of the implicit integrator, linearised once
+    /// per step.
+    pub fn hessians_into(&self, x: &[Point3], k: Stiffness, h: &mut SpringHessians) {
+        h.edges.resize(self.edges.len(), [0.0; 5]);
+        h.virtuals.resize(self.virtuals.len(), [0.0; 5]);
+        h.edges
+            .par_iter_mut()
+            .with_min_len(4096)
+            .zip(&self.edges)
+            .zip(&self.edge_rest)
+            .zip(&self.edge_scale)
+            .for_each(|(((o, s), &r), &l)| *o = hessian(edge_delta(x, s), r, k.edge * l));
+        h.virtuals
+            .par_iter_mut()
+            .with_min_len(4096)
+            .zip(&self.virtuals)
+            .zip(&self.virtual_rest)
+            .zip(&self.virtual_scale)
+            .for_each(|(((o, s), &r), &l)| *o = hessian(virtual_delta(x, s), r, k.virtual_ * l));
+    }
+
+    /// Adds `K w` into `out` with the Hessians of [`hessians_into`](Self::hessians_into).
+    /// Virtual springs are processed face by face: a face's corners are read
+    /// and written once for all its springs.
+    pub fn add_hessian_product(&self, h: &SpringHessians, w: &[Vector3], out: &mut [Vector3]) {
         let ne = self.edges.len();
-        scatter_sum(self.len(), self.num_points, out, |range, acc| {
-            for s in range {
-                if s < ne {
-                    let e = &self.edges[s];
+        let nf = self.face_offsets.len().saturating_sub(1);
+        scatter_sum(ne + nf, self.num_points, out, |range, acc| {
+            for item in range {
+                if item < ne {
+                    let e = &self.edges[item];
                     let dw = w[e[0] as usize] - w[e[1] as usize];
-                    let y = hessian_times(
-                        edge_delta(x, e),
-                        self.edge_rest[s],
-                        k.edge * self.edge_scale[s],
-                        dw,
-                    );
+                    let y = hessian_times(&h.edges[item], dw);
                     acc[e[0] as usize] += y;
                     acc[e[1] as usize] -= y;
+                    continue;
+                }
+                let f = item - ne;
+                let (a, b) = (
+                    self.face_offsets[f] as usize,
+                    self.face_offsets[f + 1] as usize,
+                );
+                let k = b - a;
+                if k <= 8 {
+                    // Corner i of the face is spring a + i, its neighbours i − 1 and i + 1.
+                    let mut wl = [Vector3::zeros(); 8];
+                    let mut yl = [Vector3::zeros(); 8];
+                    for i in 0..k {
+                        wl[i] = w[self.virtuals[a + i][0] as usize];
+                    }
+                    for i in 0..k {
+                        let (p, n) = ((i + k - 1) % k, (i + 1) % k);
+                        let y = hessian_times(&h.virtuals[a + i], wl[i] - 0.5 * (wl[p] + wl[n]));
+                        yl[i] += y;
+                        yl[p] -= 0.5 * y;
+                        yl[n] -= 0.5 * y;
+                    }
+                    for i in 0..k {
+                        acc[self.virtuals[a + i][0] as usize] += yl[i];
+                    }
                 } else {
-                    let v = s - ne;
-                    let e = &self.virtuals[v];
-                    let dw = w[e[0] as usize] - 0.5 * (w[e[1] as usize] + w[e[2] as usize]);
-                    let y = hessian_times(
-                        virtual_delta(x, e),
-                        self.virtual_rest[v],
-                        k.virtual_ * self.virtual_scale[v],
-                        dw,
-                    );
-                    acc[e[0] as usize] += y;
-                    acc[e[1] as usize] -= 0.5 * y;
-                    acc[e[2] as usize] -= 0.5 * y;
+                    for v in a..b {
+                        let e = &self.virtuals[v];
+                        let dw = w[e[0] as usize] - 0.5 * (w[e[1] as usize] + w[e[2] as usize]);
+                        let y = hessian_times(&h.virtuals[v], dw);
+                        acc[e[0] as usize] += y;
+                        acc[e[1] as usize] -= 0.5 * y;
+                        acc[e[2] as usize] -= 0.5 * y;
+                    }
                 }
             }
             0.0
