@@ -5,7 +5,8 @@
 use subdyn::lattice::{Lattice, box_grid};
 use subdyn::math::{Point3, Real, Vector3};
 use subdyn::solid::{
-    Solid, SolidParams, SpringHessians, SpringNetwork, Stiffness, extrude_face, trim_cell,
+    ExplicitScheme, Solid, SolidParams, SpringHessians, SpringNetwork, Stiffness, extrude_face,
+    trim_cell,
 };
 
 mod common;
@@ -578,4 +579,33 @@ fn bench_sculpt_rejects_absurd_arguments() {
         assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
         assert_eq!(err.trim().lines().count(), 1, "{err}");
     }
+}
+
+#[test]
+fn the_update_as_printed_gains_energy_where_symplectic_euler_does_not() {
+    // McDonnell & Qin §4.3 write p_{i+1} = p_i + ṗ_i Δt (forward Euler):
+    // without damping every oscillation grows. The default (symplectic)
+    // update keeps the energy bounded at the same step.
+    let run = |scheme: ExplicitScheme| {
+        let params = SolidParams {
+            level: 1,
+            damping: 0.0,
+            scheme,
+            ..SolidParams::default()
+        };
+        let mut s = Solid::new(&cube(), params).unwrap();
+        perturb(&mut s, 0.05);
+        let e0 = s.energy();
+        let mut range: (Real, Real) = (1.0, 1.0);
+        for _ in 0..1000 {
+            s.step_explicit(1e-3).unwrap();
+            let r = s.energy() / e0;
+            range = (range.0.min(r), range.1.max(r));
+        }
+        range
+    };
+    let symplectic = run(ExplicitScheme::SymplecticEuler);
+    let forward = run(ExplicitScheme::ForwardEuler);
+    assert!(symplectic.0 > 0.8 && symplectic.1 < 1.25, "{symplectic:?}");
+    assert!(forward.1 > 2.0, "{forward:?}");
 }
