@@ -328,6 +328,10 @@ fn bad_input_is_an_error() {
         .unwrap();
     assert!(s.extrude(interior).is_err());
     assert!(s.trim(8).is_err());
+    // Failed edits leave the solid as it was.
+    assert_eq!(s.control_points().len(), 27);
+    assert_eq!(s.mass_points().len(), 125);
+    assert_eq!(s.control_lattice().topology, cube().topology);
     let params = SolidParams {
         level: 9,
         ..SolidParams::default()

@@ -185,7 +185,17 @@ impl Solid {
     /// Extrudes boundary face `face` of the control lattice (current shape
     /// and rest shape each along their own normal); new control points move
     /// with the velocity of the points they were copied from and are free.
+    /// On error the solid is left unchanged.
     pub fn extrude(&mut self, face: usize) -> Result<()> {
+        let backup = self.clone();
+        let result = self.extrude_unchecked(face);
+        if result.is_err() {
+            *self = backup;
+        }
+        result
+    }
+
+    fn extrude_unchecked(&mut self, face: usize) -> Result<()> {
         let topo = &self.control.topology;
         let (new_topo, base) = extruded_topology(topo, face)?;
         let off = extrusion_offset(&self.p, topo, face)?;
@@ -200,8 +210,18 @@ impl Solid {
         self.replace_topology(new_topo)
     }
 
-    /// Removes cell `cell` of the control lattice.
+    /// Removes cell `cell` of the control lattice. On error the solid is
+    /// left unchanged.
     pub fn trim(&mut self, cell: usize) -> Result<()> {
+        let backup = self.clone();
+        let result = self.trim_unchecked(cell);
+        if result.is_err() {
+            *self = backup;
+        }
+        result
+    }
+
+    fn trim_unchecked(&mut self, cell: usize) -> Result<()> {
         let (new_topo, map) = trimmed_topology(&self.control.topology, cell)?;
         self.p = keep(&self.p, &map);
         self.p_rest = keep(&self.p_rest, &map);

@@ -116,7 +116,8 @@ impl Solid {
         self.ropes.clear();
     }
 
-    /// Fixes (`fixed = true`) or frees control points; rebuilds the partition.
+    /// Fixes (`fixed = true`) or frees control points; rebuilds the partition
+    /// (on error the fixed set is left unchanged). Fixed points stop.
     pub fn set_fixed(&mut self, points: &[usize], fixed: bool) -> Result<()> {
         if let Some(&i) = points.iter().find(|&&i| i >= self.p.len()) {
             return Err(Error::Input(format!(
@@ -124,10 +125,15 @@ impl Solid {
                 self.p.len()
             )));
         }
+        let before = self.fixed.clone();
         for &i in points {
             self.fixed[i] = fixed;
         }
-        self.rebuild_partition()
+        let result = self.rebuild_partition();
+        if result.is_err() {
+            self.fixed = before;
+        }
+        result
     }
 
     /// Changes the spring stiffnesses (per unit rest length).
