@@ -21,7 +21,8 @@
 //! (CSR stencil tables), [`limit`] (limit masks, exact evaluation, closest point),
 //! [`metrics`] (point-to-mesh distances, Chamfer, Hausdorff), [`render`]
 //! (software rasteriser for pictures), [`finetune`] (fine tuning of curves by
-//! scaling derivatives).
+//! scaling derivatives), [`lattice`] (volume lattices, Catmull-Clark volume
+//! refinement), [`solid`] (dynamic subdivision solids and sculpting tools).
 
 #![warn(missing_docs)]
 
@@ -39,6 +40,7 @@ pub mod math;
 pub mod mesh;
 pub mod metrics;
 pub mod render;
+pub mod solid;
 pub mod stencil;
 pub mod subdivision;
 pub mod topology;

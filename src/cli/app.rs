@@ -8,7 +8,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use super::{
-    bench, common, compare, ffd, finetune, fit, info, lattice, limit, recover, render, subdivide,
+    bench, common, compare, ffd, finetune, fit, info, lattice, limit, recover, render, sculpt,
+    subdivide,
 };
 
 /// subdyn: Catmull-Clark subdivision surfaces — refinement as stencil tables,
@@ -47,6 +48,8 @@ enum Command {
     Lattice(lattice::LatticeArgs),
     /// Free-form deformation of a mesh with a Catmull-Clark volume lattice of any topology.
     Ffd(ffd::FfdArgs),
+    /// Sculpt a dynamic subdivision solid with a scripted session (ropes, extrude, trim, fix, plastic), or the built-in --demo.
+    Sculpt(sculpt::SculptArgs),
     /// Benchmarks (timings as a table, then one JSON line).
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -68,6 +71,7 @@ pub fn run() -> ExitCode {
         Command::Finetune(cmd) => finetune::run(&cmd),
         Command::Ffd(args) => ffd::run(&args),
         Command::Lattice(args) => lattice::run(&args),
+        Command::Sculpt(args) => sculpt::run(&args),
         Command::Bench(cmd) => bench::run(&cmd),
     };
     match result {

@@ -6,6 +6,7 @@ mod bench_closest;
 mod bench_distance;
 mod bench_ffd;
 mod bench_recover;
+mod bench_sculpt;
 mod common;
 mod compare;
 mod ffd;
@@ -22,6 +23,9 @@ mod options;
 mod progress;
 mod recover;
 mod render;
+mod sculpt;
+mod sculpt_demo;
+mod sculpt_script;
 mod subdivide;
 mod subdivide_scheme;
 

@@ -85,7 +85,7 @@ pub fn fit_point_cloud(
         // pieces: exact on regular faces (one bicubic each).
         let qtable = engine.table();
         let s = qtable.to_level();
-        let area = parameter_area(&qtable);
+        let area = parameter_area(qtable);
         let material = MaterialParams::thin_plate(params.tension, params.bending, area);
         let k = patch_stiffness_matrix(qtable, params.quadrature_order, &material)?;
         let d = patch_damping_matrix(qtable, params.quadrature_order, params.damping / area)?;
