@@ -68,7 +68,23 @@ pub fn fit_point_cloud(
     );
     let mut mesh = init.clone();
     let mut levels = Vec::new();
-    let n = points.len() as Real;
+    // A fixed pseudo-random order of the points: each level uses a prefix
+    // of it, so coarse levels see an even subsample.
+    let shuffled: Vec<Point3> = {
+        let mut order: Vec<(u64, usize)> = (0..points.len())
+            .map(|i| {
+                (
+                    (i as u64 + 1)
+                        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+                        .rotate_left(29),
+                    i,
+                )
+            })
+            .collect();
+        order.sort_unstable();
+        order.into_iter().map(|(_, i)| points[i]).collect()
+    };
+    let n_all = points.len() as Real;
     let (converged, stop_reason) = loop {
         let level = levels.len();
         let level_start = Instant::now();
@@ -113,22 +129,31 @@ pub fn fit_point_cloud(
         let mut cg_iterations = 0;
         let mut steps = 0;
         let mut hints: Option<Vec<(u32, [Real; 2])>> = None;
+        let used = &shuffled[..shuffled
+            .len()
+            .min(
+                params
+                    .points_per_control_point
+                    .saturating_mul(mesh.num_vertices()),
+            )
+            .max(4)];
+        let n = used.len() as Real;
         loop {
             // Newton from the previous answers every step; every
             // `reseed_every` steps also from the nearest seed, to catch jumps
             // to another part of the surface.
             let closest = match &hints {
                 Some(h) if steps % params.reseed_every != 0 => {
-                    engine.closest_points_local(points, h)?
+                    engine.closest_points_local(used, h)?
                 }
-                Some(h) => engine.closest_points_near(points, h)?,
-                None => engine.closest_points(points)?,
+                Some(h) => engine.closest_points_near(used, h)?,
+                None => engine.closest_points(used)?,
             };
             hints = Some(closest.iter().map(|c| c.patch).collect());
             let dist: Vec<Real> = closest.iter().map(|c| c.distance).collect();
             let w = robust_weights(&dist, params.robust, 1e-6 * diameter);
             let kw: Vec<Real> = w.iter().map(|w| w / n).collect();
-            let mut springs = spring_system(&engine, points, &closest, &kw)?;
+            let mut springs = spring_system(&engine, used, &closest, &kw)?;
             if params.surface_weight > 0.0 {
                 // Surface-to-data springs: every surface sample to its
                 // nearest data point, so parts of the surface that no data
@@ -209,7 +234,8 @@ pub fn fit_point_cloud(
             step_rms_pct,
             step_p95_pct,
             error,
-            rejected: w.iter().filter(|&&w| w == 0.0).count() as Real / n,
+            points_used: used.len(),
+            rejected: w.iter().filter(|&&w| w == 0.0).count() as Real / n_all,
         });
         let stat = match params.tolerance_stat {
             ToleranceStat::Max => error.max_pct,
@@ -238,7 +264,7 @@ pub fn fit_point_cloud(
             );
         }
         let h = refiner.refine_uniform(1)?;
-        if h.level(1).num_vertices as Real > params.max_control_fraction * n {
+        if h.level(1).num_vertices as Real > params.max_control_fraction * n_all {
             break (
                 false,
                 format!(

@@ -62,6 +62,11 @@ pub struct FitParams {
     /// its nearest data point, Huber-weighted) relative to the data-to-surface
     /// springs (default 0.5; 0 turns them off).
     pub surface_weight: Real,
+    /// A level's springs use at most this many data points per control
+    /// point (default 20), an even subsample of the cloud: coarse levels
+    /// cannot resolve more, and the cost of a step follows the points used.
+    /// The error of every level is still measured on all points.
+    pub points_per_control_point: usize,
     /// Relative residual at which the conjugate-gradient solve of each
     /// implicit step stops (default 1e-5): the step is re-linearised at once,
     /// so solving it further buys nothing.
@@ -95,6 +100,7 @@ impl Default for FitParams {
             damping: 0.05,
             surface_weight: 0.5,
             cg_tolerance: 1e-5,
+            points_per_control_point: 20,
             surface_samples: 2,
             robust: RobustKernel::default(),
             patch_level: 1,
@@ -142,6 +148,9 @@ impl FitParams {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(name, v, "must be finite and ≥ 0");
             }
+        }
+        if self.points_per_control_point == 0 {
+            return bad("points_per_control_point", 0.0, "expected at least 1");
         }
         if !(self.cg_tolerance > 0.0 && self.cg_tolerance < 1.0) {
             return bad(

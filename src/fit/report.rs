@@ -79,7 +79,10 @@ pub struct LevelReport {
     pub step_rms_pct: Vec<Real>,
     /// 95th-percentile distance (% of the diameter) at each entry of `energy`.
     pub step_p95_pct: Vec<Real>,
-    /// Distances from the data points to the surface at the end of the level.
+    /// Data points the level's springs used (a subsample on coarse levels,
+    /// see [`FitParams::points_per_control_point`](super::FitParams)).
+    pub points_used: usize,
+    /// Distances from all data points to the surface at the end of the level.
     pub error: ErrorStats,
     /// Fraction of data points whose robust weight is zero (rejected outliers).
     pub rejected: Real,
