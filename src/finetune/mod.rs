@@ -13,6 +13,7 @@
 //! edge loops, the spring energy (14) (`surface_energy`, `surface_targets`)
 //! minimised by nonlinear conjugate gradient (`surface_solve`, `surface`).
 
+mod angle_curvature;
 mod convert;
 mod curve;
 mod curve_alpha;
@@ -20,10 +21,14 @@ mod curve_bspline;
 mod curve_energy;
 mod curve_exact;
 mod curve_frames;
+mod curve_gauss_newton;
 mod curve_io;
 mod curve_picture;
 mod curve_solver;
 mod edge_loops;
+mod levenberg_marquardt;
+mod min_degree;
+mod sparse_cholesky;
 mod surface;
 mod surface_energy;
 mod surface_solve;
@@ -33,13 +38,17 @@ pub use convert::{Conversion, ConvertedEdge, conversion_weight, doo_sabin_to_non
 pub use curve::{CurveFinetune, CurveFinetuneParams, CurveFinetuneReport, finetune_curve};
 pub use curve_alpha::{ScalarFunction, ValuesOn, alpha_from_values, values_on};
 pub use curve_bspline::BSplineCurve;
-pub use curve_energy::{SpringTargets, joint_angle};
+pub use curve_energy::{SpringTargets, joint_angle, joint_angle_gradients, wrap_angle};
 pub use curve_exact::{
     ExactFinetune, closed_spline, exact_finetune, finetuned_spans, spline_from_spans,
 };
 pub use curve_io::{curve_json, read_alpha, read_curve, write_json};
 pub use curve_picture::{CurveLayer, curve_picture};
 pub use edge_loops::{EdgeLoop, edge_loops};
+pub use levenberg_marquardt::{
+    FinetuneMethod, LeastSquares, LmParams, LmRun, Residuals, levenberg_marquardt,
+};
+pub use sparse_cholesky::{Cholesky, CholeskyPattern};
 pub use surface::{SurfaceFineTune, SurfaceFineTuneParams, SurfaceFineTuneReport, SurfaceScheme};
 pub use surface_energy::{SpringEnergy, angle_and_gradients, joint_angles};
 pub use surface_targets::{LegKind, loop_targets};
