@@ -254,6 +254,8 @@ impl CurveFinetune {
                 let lm = LmParams {
                     gradient_tolerance: self.params.gradient_tolerance,
                     max_iterations: self.params.max_iterations,
+                    stall_window: 0,
+                    stall_relative: 0.0,
                 };
                 let run = levenberg_marquardt(&points, &vec![0.0; points.num_vars()], &lm);
                 let x = setup.problem.variables(&points.points(&run.z));

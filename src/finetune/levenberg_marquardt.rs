@@ -14,6 +14,7 @@
 //! decrease, on rejection `λ ← λ ν`, `ν ← 2ν`.
 //!
 //! It stops when the problem's gradient norm is at most the tolerance, when
+//! the energy fell too little over a window of iterations (optional), when
 //! the predicted decrease of a rejected step is below rounding level
 //! (`1e-14 E`: the energy has stalled), or at the iteration limit. Compared
 //! with nonlinear CG, which needs thousands of iterations on these
@@ -111,6 +112,11 @@ pub struct LmParams {
     pub gradient_tolerance: Real,
     /// Iteration limit (accepted steps).
     pub max_iterations: u64,
+    /// Stop when `E` fell by less than `stall_relative · E` over the last
+    /// `stall_window` iterations (0 disables the rule).
+    pub stall_window: usize,
+    /// See `stall_window`.
+    pub stall_relative: Real,
 }
 
 /// The termination text when the energy can no longer resolve progress.
@@ -189,6 +195,17 @@ pub fn levenberg_marquardt<P: LeastSquares>(problem: &P, z0: &[Real], params: &L
         if gnorm <= params.gradient_tolerance {
             run.converged = true;
             run.termination = LM_CONVERGED.into();
+            break;
+        }
+        let n_e = run.energies.len();
+        if params.stall_window > 0
+            && n_e > params.stall_window
+            && run.energies[n_e - 1 - params.stall_window] - e <= params.stall_relative * e.abs()
+        {
+            run.termination = format!(
+                "energy fell by less than {:e} (relative) over the last {} iterations",
+                params.stall_relative, params.stall_window
+            );
             break;
         }
         if run.iterations >= params.max_iterations {

@@ -31,6 +31,7 @@ mod min_degree;
 mod sparse_cholesky;
 mod surface;
 mod surface_energy;
+mod surface_gauss_newton;
 mod surface_solve;
 mod surface_targets;
 
