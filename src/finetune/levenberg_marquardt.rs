@@ -8,10 +8,14 @@
 //! of its largest entry so that it is positive definite), by the sparse
 //! Cholesky of `sparse_cholesky` (pattern and ordering computed once). A step
 //! is accepted only if it lowers `E`, so the recorded energies never rise;
-//! `λ` follows Nielsen's rule (Madsen, Nielsen, Tingleff, *Methods for
-//! non-linear least squares problems*, 2004, §3.2): on acceptance
-//! `λ ← λ max(1/3, 1 − (2ρ − 1)³)` with `ρ` the ratio of actual to predicted
-//! decrease, on rejection `λ ← λ ν`, `ν ← 2ν`.
+//! `λ` starts at [`LAMBDA_START`] (nearly a Gauss-Newton step: `D` makes
+//! it relative) and follows Nielsen's rule (Madsen, Nielsen, Tingleff,
+//! *Methods for non-linear least squares problems*, 2004, §3.2): on
+//! acceptance `λ ← λ max(1/10, 1 − (2ρ − 1)³)` with `ρ` the ratio of actual
+//! to predicted decrease (Nielsen bounds the factor by 1/3; 1/10 lets good
+//! steps approach Gauss-Newton sooner: 4 instead of 11 iterations on the
+//! benchmark surface, 6 instead of 15 on the benchmark curve), on rejection
+//! `λ ← λ ν`, `ν ← 2ν`.
 //!
 //! It stops when the problem's gradient norm is at most the tolerance, when
 //! the energy fell too little over a window of iterations (optional), when
@@ -119,6 +123,11 @@ pub struct LmParams {
     pub stall_relative: Real,
 }
 
+/// The starting damping `λ` (relative to `diag(H)`): `1e-6`. Starting at
+/// Nielsen's `1e-3` cost 11 iterations instead of 4 on the benchmark
+/// surface; a first step that is too long is rejected and `λ` grows.
+pub const LAMBDA_START: Real = 1e-6;
+
 /// The termination text when the energy can no longer resolve progress.
 pub const LM_STALLED: &str = "energy stalled at rounding level";
 /// The termination text when the gradient tolerance is reached.
@@ -147,16 +156,22 @@ pub fn levenberg_marquardt<P: LeastSquares>(problem: &P, z0: &[Real], params: &L
     let mut z = z0.to_vec();
     let mut rows = Residuals::default();
     problem.residuals(&z, &mut rows);
-    // Positions of H assembled row by row (pairs p ≤ q), then the diagonal.
-    let mut positions = Vec::new();
+    // Rows with the same variables as the row before share its slots (the
+    // curvature rows follow their angle row).
+    let mut groups: Vec<&[usize]> = Vec::new();
+    let mut row_slot = Vec::with_capacity(rows.values.len());
+    let mut total = 0;
     for k in 0..rows.values.len() {
         let vars = &rows.vars[rows.start[k]..rows.start[k + 1]];
-        for (p, &a) in vars.iter().enumerate() {
-            positions.extend(vars[p..].iter().map(|&b| (a, b)));
+        if groups.last() == Some(&vars) {
+            row_slot.push(row_slot[k - 1]);
+        } else {
+            row_slot.push(total);
+            total += vars.len() * (vars.len() + 1) / 2;
+            groups.push(vars);
         }
     }
-    positions.extend((0..n).map(|i| (i, i)));
-    let (pattern, slots) = CholeskyPattern::new(n, &problem.nodes(), &positions);
+    let (pattern, slots) = CholeskyPattern::new(n, &problem.nodes(), &groups);
     let diag_slots = &slots[slots.len() - n..];
     let mut h = vec![0.0; pattern.num_values()];
     let mut g = vec![0.0; n];
@@ -168,15 +183,16 @@ pub fn levenberg_marquardt<P: LeastSquares>(problem: &P, z0: &[Real], params: &L
         converged: false,
         termination: String::new(),
     };
-    let (mut lambda, mut nu) = (1e-3, 2.0);
+    drop(groups);
+    let (mut lambda, mut nu) = (LAMBDA_START, 2.0);
     loop {
         // E, g = 2 Jᵀr and H = 2 JᵀJ at z.
         h.iter_mut().for_each(|v| *v = 0.0);
         g.iter_mut().for_each(|v| *v = 0.0);
         let mut e = 0.0;
-        let mut s = 0;
-        for k in 0..rows.values.len() {
+        for (k, &first_slot) in row_slot.iter().enumerate() {
             let (r, range) = (rows.values[k], rows.start[k]..rows.start[k + 1]);
+            let mut s = first_slot;
             e += r * r;
             let (vars, grads) = (&rows.vars[range.clone()], &rows.grads[range]);
             for (p, (&a, &ga)) in vars.iter().zip(grads).enumerate() {
@@ -237,7 +253,7 @@ pub fn levenberg_marquardt<P: LeastSquares>(problem: &P, z0: &[Real], params: &L
             let predicted = 0.5 * (lambda * damp - g_step);
             if e_new.is_finite() && e_new < e && predicted > 0.0 {
                 let rho = (e - e_new) / predicted;
-                lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
+                lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(0.1);
                 nu = 2.0;
                 break Some(trial);
             }

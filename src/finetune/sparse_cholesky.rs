@@ -1,127 +1,162 @@
 //! A small sparse Cholesky factorisation `P A Pᵀ = L Lᵀ` for the
 //! Gauss-Newton systems of fine tuning (symmetric positive definite, a few
-//! thousand unknowns, the same pattern at every step).
+//! thousand unknowns, the same pattern at every step), in 3 × 3 blocks.
 //!
 //! Up-looking algorithm (Davis, *Direct Methods for Sparse Linear Systems*,
-//! 2006, §4.2 and §4.6: elimination tree, row patterns by `ereach`), with a
-//! minimum-degree ordering of a node graph (`min_degree`). Written here
-//! rather than adding faer because the systems are small and the pattern,
-//! ordering and symbolic factor are computed once per solve and reused.
+//! 2006, §4.2 and §4.6: elimination tree, row patterns by `ereach`) on the
+//! graph of nodes (a point's unknowns), with a minimum-degree ordering
+//! (`min_degree`). Every node is a block of 3 unknowns (nodes with fewer get
+//! unit-diagonal padding, nodes with more are split), so the inner loops are
+//! 3 × 3 matrix products: `Z_i = L_ii⁻¹ X_i`, `X_r −= L_ri Z_i`,
+//! `D −= Z_iᵀ Z_i`, `L_ki = Z_iᵀ`, `L_kk = chol(D)`. Written here rather than
+//! adding faer because the systems are small and the pattern, ordering and
+//! symbolic factor are computed once per solve and reused.
 //!
-//! Usage: [`CholeskyPattern::new`] with the list of `(i, j)` positions that
-//! will be assembled (in any orientation, repeats allowed) returns, for each
-//! listed position, its slot in [`CholeskyPattern::values`]-sized storage;
-//! [`CholeskyPattern::factor`] factors the assembled values.
+//! Usage: [`CholeskyPattern::new`] with the groups of unknowns that will be
+//! assembled together returns the slot of every pair in a value array of
+//! [`CholeskyPattern::num_values`] entries; [`CholeskyPattern::factor`]
+//! factors the assembled values.
+
+use nalgebra::{Matrix3, Vector3};
 
 use crate::math::Real;
 
 use super::min_degree::min_degree;
 
-/// Ordering, pattern of `P A Pᵀ` (upper triangle by columns) and symbolic
-/// factor of a sparse symmetric matrix.
+/// Ordering, block pattern of `P A Pᵀ` (upper triangle by block columns) and
+/// symbolic factor of a sparse symmetric matrix.
 #[derive(Clone, Debug)]
 pub struct CholeskyPattern {
     n: usize,
-    /// `perm[new] = old`.
-    perm: Vec<usize>,
-    /// Column starts of the upper triangle of `C = P A Pᵀ`.
+    /// Block (in elimination order) and place in it of every unknown.
+    place: Vec<(usize, usize)>,
+    /// Padding places `(block, k)`: unit diagonal.
+    padding: Vec<(usize, usize)>,
+    /// Block column starts of the upper triangle of `C = P A Pᵀ`.
     c_start: Vec<usize>,
-    /// Row indices of `C` (each column sorted, diagonal last).
+    /// Block row indices of `C` (each column sorted, diagonal last).
     c_rows: Vec<usize>,
-    /// Elimination tree of `C`.
+    /// Elimination tree of the blocks.
     parent: Vec<Option<usize>>,
-    /// Column starts of `L`.
+    /// Block column starts of `L`.
     l_start: Vec<usize>,
 }
 
-/// A numeric factor `L` (columns, diagonal first) with its pattern.
+/// A numeric factor `L` (block columns, diagonal block first) with its pattern.
 #[derive(Clone, Debug)]
 pub struct Cholesky<'a> {
     pattern: &'a CholeskyPattern,
     rows: Vec<usize>,
-    values: Vec<Real>,
+    blocks: Vec<Matrix3<Real>>,
+    /// `L_kk⁻¹` of every diagonal block.
+    inverse: Vec<Matrix3<Real>>,
 }
 
 impl CholeskyPattern {
-    /// The pattern of an `n × n` matrix with entries at `positions` (each
-    /// `(i, j)` stands for both `(i, j)` and `(j, i)`; the diagonal is always
-    /// included), ordered by minimum degree of the graph on `node_of[i]`
-    /// (unknowns of one node stay together). Returns the pattern and, for
-    /// every entry of `positions`, its slot in the value array.
-    pub fn new(
-        n: usize,
-        node_of: &[usize],
-        positions: &[(usize, usize)],
-    ) -> (CholeskyPattern, Vec<usize>) {
+    /// The pattern of an `n × n` matrix assembled from `groups` (each a list
+    /// of unknowns whose every pair is an entry; repeats allowed) and the
+    /// diagonal, ordered by minimum degree of the graph on `node_of[i]`
+    /// (unknowns of one node form one block). Returns the pattern and the
+    /// slots in the value array: for each group, its pairs `(p, q)` with
+    /// `p ≤ q` (positions in the group) in order, then the diagonal of
+    /// unknowns `0 … n − 1`.
+    pub fn new(n: usize, node_of: &[usize], groups: &[&[usize]]) -> (CholeskyPattern, Vec<usize>) {
+        // Blocks: the unknowns of each node in chunks of 3.
         let num_nodes = node_of.iter().map(|&v| v + 1).max().unwrap_or(0);
-        let mut node_adj = vec![Vec::new(); num_nodes];
-        for &(i, j) in positions {
-            let (a, b) = (node_of[i], node_of[j]);
-            if a != b {
-                node_adj[a].push(b);
-                node_adj[b].push(a);
+        let mut members = vec![Vec::new(); num_nodes];
+        for (i, &v) in node_of.iter().enumerate() {
+            members[v].push(i);
+        }
+        let mut block_of = vec![(0, 0); n];
+        let mut sizes = Vec::new();
+        for m in members.iter().filter(|m| !m.is_empty()) {
+            for chunk in m.chunks(3) {
+                for (k, &i) in chunk.iter().enumerate() {
+                    block_of[i] = (sizes.len(), k);
+                }
+                sizes.push(chunk.len());
             }
         }
-        for a in &mut node_adj {
+        let nb = sizes.len();
+        let mut adj = vec![Vec::new(); nb];
+        let mut blocks = Vec::new();
+        for group in groups {
+            blocks.clear();
+            blocks.extend(group.iter().map(|&i| block_of[i].0));
+            blocks.sort_unstable();
+            blocks.dedup();
+            for (p, &a) in blocks.iter().enumerate() {
+                for &b in &blocks[p + 1..] {
+                    adj[a].push(b);
+                    adj[b].push(a);
+                }
+            }
+        }
+        for a in &mut adj {
             a.sort_unstable();
             a.dedup();
         }
-        let node_order = min_degree(&node_adj);
-        let mut node_rank = vec![0; num_nodes];
-        for (r, &v) in node_order.iter().enumerate() {
-            node_rank[v] = r;
+        let order = min_degree(&adj);
+        let mut rank = vec![0; nb];
+        for (r, &b) in order.iter().enumerate() {
+            rank[b] = r;
         }
-        let mut perm: Vec<usize> = (0..n).collect();
-        perm.sort_by_key(|&i| (node_rank[node_of[i]], i));
-        let mut inv = vec![0; n];
-        for (new, &old) in perm.iter().enumerate() {
-            inv[old] = new;
-        }
-        // Upper triangle of C by columns: (row ≤ col).
-        let mut entries: Vec<(usize, usize)> = positions
-            .iter()
-            .map(|&(i, j)| {
-                let (a, b) = (inv[i], inv[j]);
-                (a.max(b), a.min(b))
-            })
-            .chain((0..n).map(|k| (k, k)))
-            .collect();
-        entries.sort_unstable();
-        entries.dedup();
-        let mut c_start = vec![0; n + 1];
-        for &(col, _) in &entries {
-            c_start[col + 1] += 1;
-        }
-        for k in 0..n {
-            c_start[k + 1] += c_start[k];
-        }
-        let c_rows: Vec<usize> = entries.iter().map(|&(_, row)| row).collect();
-        let slots = positions
-            .iter()
-            .map(|&(i, j)| {
-                let (a, b) = (inv[i], inv[j]);
-                let (col, row) = (a.max(b), a.min(b));
-                let s = c_start[col];
-                s + c_rows[s..c_start[col + 1]].partition_point(|&r| r < row)
+        let place: Vec<(usize, usize)> = block_of.iter().map(|&(b, k)| (rank[b], k)).collect();
+        let padding = (0..nb)
+            .flat_map(|b| {
+                let r = rank[b];
+                (sizes[b]..3).map(move |k| (r, k))
             })
             .collect();
-        let parent = elimination_tree(n, &c_start, &c_rows);
-        let mut counts = vec![1usize; n];
-        let mut mark = vec![usize::MAX; n];
+        // Upper triangle of C by block columns: rows ≤ col, sorted, diagonal last.
+        let mut c_start = vec![0; nb + 1];
+        let mut c_rows = Vec::new();
+        for (k, &b) in order.iter().enumerate() {
+            let first = c_rows.len();
+            c_rows.extend(adj[b].iter().map(|&a| rank[a]).filter(|&r| r < k));
+            c_rows[first..].sort_unstable();
+            c_rows.push(k);
+            c_start[k + 1] = c_rows.len();
+        }
+        let slot = |i: usize, j: usize| {
+            let (pi, pj) = (place[i], place[j]);
+            // In the block: (row unknown, column unknown); the diagonal
+            // block keeps its upper triangle.
+            let ((row, r), (col, c)) = if pi.0 <= pj.0 { (pi, pj) } else { (pj, pi) };
+            let (r, c) = if row == col {
+                (r.min(c), r.max(c))
+            } else {
+                (r, c)
+            };
+            let s = c_start[col];
+            let blk = s + c_rows[s..c_start[col + 1]].partition_point(|&x| x < row);
+            9 * blk + 3 * r + c
+        };
+        let mut slots = Vec::new();
+        for group in groups {
+            for (p, &i) in group.iter().enumerate() {
+                slots.extend(group[p..].iter().map(|&j| slot(i, j)));
+            }
+        }
+        slots.extend((0..n).map(|i| slot(i, i)));
+        let parent = elimination_tree(nb, &c_start, &c_rows);
+        let mut counts = vec![1usize; nb];
+        let mut mark = vec![usize::MAX; nb];
         let mut stack = Vec::new();
-        for k in 0..n {
+        for k in 0..nb {
             row_pattern(k, &c_start, &c_rows, &parent, &mut mark, &mut stack);
             for &i in &stack {
                 counts[i] += 1;
             }
         }
-        let mut l_start = vec![0; n + 1];
-        for k in 0..n {
+        let mut l_start = vec![0; nb + 1];
+        for k in 0..nb {
             l_start[k + 1] = l_start[k] + counts[k];
         }
         let pattern = CholeskyPattern {
             n,
-            perm,
+            place,
+            padding,
             c_start,
             c_rows,
             parent,
@@ -130,28 +165,34 @@ impl CholeskyPattern {
         (pattern, slots)
     }
 
-    /// Number of stored values of `P A Pᵀ` (the length of the value array).
+    /// Length of the value array (9 per stored block of `P A Pᵀ`).
     pub fn num_values(&self) -> usize {
-        self.c_rows.len()
+        9 * self.c_rows.len()
     }
 
-    /// Nonzeros of the factor `L`.
-    pub fn factor_nonzeros(&self) -> usize {
-        self.l_start[self.n]
+    /// Stored 3 × 3 blocks of the factor `L`.
+    pub fn factor_blocks(&self) -> usize {
+        self.l_start[self.l_start.len() - 1]
     }
 
     /// The factor of the matrix whose upper triangle (in the slots returned by
     /// [`new`](Self::new)) is `values`; `None` if it is not positive definite.
     pub fn factor(&self, values: &[Real]) -> Option<Cholesky<'_>> {
-        let n = self.n;
-        let nnz = self.l_start[n];
+        let nb = self.l_start.len() - 1;
+        let block = |p: usize| Matrix3::from_fn(|r, c| values[9 * p + 3 * r + c]);
+        let mut pad = vec![[false; 3]; nb];
+        for &(b, k) in &self.padding {
+            pad[b][k] = true;
+        }
+        let nnz = self.l_start[nb];
         let mut rows = vec![0; nnz];
-        let mut lx = vec![0.0; nnz];
-        let mut next: Vec<usize> = self.l_start[..n].to_vec();
-        let mut x = vec![0.0; n];
-        let mut mark = vec![usize::MAX; n];
+        let mut lx: Vec<Matrix3<Real>> = vec![Matrix3::zeros(); nnz];
+        let mut inverse: Vec<Matrix3<Real>> = vec![Matrix3::zeros(); nb];
+        let mut next: Vec<usize> = self.l_start[..nb].to_vec();
+        let mut x: Vec<Matrix3<Real>> = vec![Matrix3::zeros(); nb];
+        let mut mark = vec![usize::MAX; nb];
         let mut stack = Vec::new();
-        for k in 0..n {
+        for k in 0..nb {
             row_pattern(
                 k,
                 &self.c_start,
@@ -160,34 +201,44 @@ impl CholeskyPattern {
                 &mut mark,
                 &mut stack,
             );
-            for p in self.c_start[k]..self.c_start[k + 1] {
-                x[self.c_rows[p]] += values[p];
+            let (first, last) = (self.c_start[k], self.c_start[k + 1] - 1);
+            for p in first..last {
+                x[self.c_rows[p]] += block(p);
             }
-            let mut d = x[k];
-            x[k] = 0.0;
+            // The diagonal block from its upper triangle, padding on the diagonal.
+            let upper = block(last);
+            let mut d = Matrix3::from_fn(|r, c| if r <= c { upper[(r, c)] } else { upper[(c, r)] });
+            for (i, &padded) in pad[k].iter().enumerate() {
+                if padded {
+                    d[(i, i)] = 1.0;
+                }
+            }
             // `stack` is in topological order (descendants first).
             for &i in &stack {
-                let lki = x[i] / lx[self.l_start[i]];
-                x[i] = 0.0;
+                let z = inverse[i] * x[i];
+                x[i] = Matrix3::zeros();
                 for p in self.l_start[i] + 1..next[i] {
-                    x[rows[p]] -= lx[p] * lki;
+                    x[rows[p]] -= lx[p] * z;
                 }
-                d -= lki * lki;
+                d -= z.transpose() * z;
                 rows[next[i]] = k;
-                lx[next[i]] = lki;
+                lx[next[i]] = z.transpose();
                 next[i] += 1;
             }
-            if !(d > 0.0 && d.is_finite()) {
+            let l = d.cholesky()?.l();
+            if !l.iter().all(|v| v.is_finite()) {
                 return None;
             }
+            inverse[k] = l.try_inverse()?;
             rows[next[k]] = k;
-            lx[next[k]] = d.sqrt();
+            lx[next[k]] = l;
             next[k] += 1;
         }
         Some(Cholesky {
             pattern: self,
             rows,
-            values: lx,
+            blocks: lx,
+            inverse,
         })
     }
 }
@@ -196,31 +247,28 @@ impl Cholesky<'_> {
     /// The solution `x` of `A x = b`.
     pub fn solution(&self, b: &[Real]) -> Vec<Real> {
         let p = self.pattern;
-        let mut x: Vec<Real> = p.perm.iter().map(|&i| b[i]).collect();
-        for j in 0..p.n {
-            let s = p.l_start[j];
-            x[j] /= self.values[s];
-            let xj = x[j];
-            for q in s + 1..p.l_start[j + 1] {
-                x[self.rows[q]] -= self.values[q] * xj;
+        let nb = p.l_start.len() - 1;
+        let mut x: Vec<Vector3<Real>> = vec![Vector3::zeros(); nb];
+        for (i, &(blk, k)) in p.place.iter().enumerate() {
+            x[blk][k] = b[i];
+        }
+        for j in 0..nb {
+            let y = self.inverse[j] * x[j];
+            x[j] = y;
+            for q in p.l_start[j] + 1..p.l_start[j + 1] {
+                x[self.rows[q]] -= self.blocks[q] * y;
             }
         }
-        for j in (0..p.n).rev() {
-            let s = p.l_start[j];
+        for j in (0..nb).rev() {
             let mut v = x[j];
-            for q in s + 1..p.l_start[j + 1] {
-                v -= self.values[q] * x[self.rows[q]];
+            for q in p.l_start[j] + 1..p.l_start[j + 1] {
+                v -= self.blocks[q].tr_mul(&x[self.rows[q]]);
             }
-            x[j] = v / self.values[s];
+            x[j] = self.inverse[j].tr_mul(&v);
         }
-        let mut out = vec![0.0; p.n];
-        for (new, &old) in p.perm.iter().enumerate() {
-            out[old] = x[new];
-        }
-        out
+        (0..p.n).map(|i| x[p.place[i].0][p.place[i].1]).collect()
     }
 }
-
 /// Elimination tree of a matrix given by its upper triangle by columns
 /// (Davis 2006, §4.1, with path compression).
 fn elimination_tree(n: usize, start: &[usize], rows: &[usize]) -> Vec<Option<usize>> {
