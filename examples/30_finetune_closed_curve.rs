@@ -45,7 +45,7 @@ fn main() -> subdyn::Result<()> {
     let tuner = CurveFinetune::new(&topo, &polygon, &alpha, &params)?;
     let (curve, report) = tuner.solve()?;
     println!(
-        "degree {} (knot multiplicity {}), {} control points; {} NCG iterations ({}), energy {:.3e} -> {:.3e}; gap {:.3} -> {:.1e}; {:.1} ms",
+        "degree {} (knot multiplicity {}), {} control points; {} Levenberg-Marquardt iterations ({}), energy {:.3e} -> {:.3e}; gap {:.3} -> {:.1e}; {:.1} ms",
         report.degree,
         report.multiplicity,
         report.num_control_points,

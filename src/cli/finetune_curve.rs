@@ -9,8 +9,8 @@ use clap::Args;
 use serde_json::json;
 
 use subdyn::finetune::{
-    CurveFinetune, CurveFinetuneParams, CurveLayer, curve_json, curve_picture, read_alpha,
-    read_curve, write_json,
+    CurveFinetune, CurveFinetuneParams, CurveLayer, FinetuneMethod, curve_json, curve_picture,
+    read_alpha, read_curve, write_json,
 };
 use subdyn::math::Real;
 use subdyn::render::{check_png_path, write_png};
@@ -41,6 +41,9 @@ pub struct CurveArgs {
     /// Index of the fixed control point of the fine-tuned polygon (closed curves).
     #[arg(long, value_name = "I", default_value_t = 0)]
     pub fix: usize,
+    /// Minimiser of energy (13): lm (Levenberg-Marquardt) or ncg (argmin's nonlinear CG).
+    #[arg(long, value_name = "lm|ncg", default_value = "lm")]
+    pub method: FinetuneMethod,
     /// Write a JSON report (energies, iterations, gaps, time).
     #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
@@ -81,6 +84,7 @@ pub fn run(args: &CurveArgs) -> anyhow::Result<()> {
         k_length,
         k_angle,
         fixed_point: args.fix,
+        method: args.method,
         ..CurveFinetuneParams::default()
     };
     let tuner = CurveFinetune::new(&topo, &points, &alpha, &params)?;
@@ -107,6 +111,7 @@ pub fn run(args: &CurveArgs) -> anyhow::Result<()> {
                 "multiplicity": report.multiplicity,
                 "control_points": report.num_control_points,
                 "variables": report.num_variables,
+                "method": format!("{:?}", args.method),
                 "iterations": report.iterations,
                 "initial_energy": report.initial_energy,
                 "final_energy": report.final_energy,

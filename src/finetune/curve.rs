@@ -7,7 +7,9 @@
 //! the same degree `D` and knot multiplicity `m`); the optimal lengths and
 //! angles are those of the unclosed exact `Q`; the curve is pre-scaled to fit
 //! the unit square (cube) and scaled back; one control point and one rotation
-//! are fixed; energy (13) is minimised by nonlinear conjugate gradient. The
+//! are fixed; energy (13) is minimised by Levenberg-Marquardt on its sparse
+//! Gauss-Newton matrix (`curve_gauss_newton`; argmin's nonlinear conjugate
+//! gradient, which issue 8 named, is [`FinetuneMethod::NonlinearCg`]). The
 //! result is a periodic B-spline, so it closes by construction; `α ≡ 1` has
 //! zero energy and zero gradient at the start and returns `P` unchanged.
 //!
@@ -93,7 +95,7 @@ pub struct CurveFinetuneReport {
     pub num_control_points: usize,
     /// Optimisation variables (0 for an open curve).
     pub num_variables: usize,
-    /// NCG iterations (0 for an open curve).
+    /// Iterations of the minimiser (0 for an open curve).
     pub iterations: usize,
     /// Energy (13) at the start and after every iteration (unit-square scaling).
     pub energies: Vec<Real>,

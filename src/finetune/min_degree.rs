@@ -28,7 +28,7 @@ pub fn min_degree(adj: &[Vec<usize>]) -> Vec<usize> {
         let clique = std::mem::take(&mut graph[v]);
         for &u in &clique {
             // adj(u) ← adj(u) ∪ clique \ {u, v}: merge of two sorted lists.
-            let old = std::mem::take(&mut graph[u]);
+            let mut old = std::mem::take(&mut graph[u]);
             merged.clear();
             let (mut a, mut b) = (0, 0);
             while a < old.len() || b < clique.len() {
@@ -56,7 +56,10 @@ pub fn min_degree(adj: &[Vec<usize>]) -> Vec<usize> {
                     merged.push(x);
                 }
             }
-            graph[u] = merged.clone();
+            // Swap buffers: `u` keeps the merge, `merged` reuses the old list.
+            old.clear();
+            std::mem::swap(&mut old, &mut merged);
+            graph[u] = old;
             heap.push(Reverse((graph[u].len(), u)));
         }
     }

@@ -2,16 +2,20 @@
 //! (fine-tuning paper, §4.2–4.4).
 //!
 //! Curves: a new curve `Q` with `Q'(t) = α(t) P'(t)`, closed curves closed
-//! again by the spring energy (13) minimised with nonlinear CG. Files:
+//! again by the spring energy (13) minimised by Levenberg-Marquardt
+//! (`levenberg_marquardt`, `sparse_cholesky`, `min_degree`,
+//! `angle_curvature`) or argmin's nonlinear CG. Files:
 //! `curve_alpha` (α from control values), `curve_exact` (exact product and
 //! integral as a B-spline), `curve_bspline` (evaluation), `curve_energy`
 //! (eq. 13), `curve_frames` (fixed point and rotation), `curve_solver` (argmin
-//! glue), `curve` (params, precompute, solve, report), `curve_io` (JSON
-//! files), `curve_picture` (top-view PNG).
+//! glue), `curve_gauss_newton` (eq. 13 as residuals), `curve` (params,
+//! precompute, solve, report), `curve_io` (JSON files), `curve_picture`
+//! (top-view PNG).
 //!
 //! Surfaces: Doo-Sabin to non-uniform Catmull-Clark conversion (`convert`),
 //! edge loops, the spring energy (14) (`surface_energy`, `surface_targets`)
-//! minimised by nonlinear conjugate gradient (`surface_solve`, `surface`).
+//! minimised by Levenberg-Marquardt (`surface_gauss_newton`) or nonlinear
+//! conjugate gradient (`surface_solve`, `surface`).
 
 mod angle_curvature;
 mod convert;

@@ -1,8 +1,10 @@
 //! Surface fine tuning (fine-tuning paper, §4.3–4.4): a Doo-Sabin control
 //! mesh is converted to a non-uniform Catmull-Clark mesh, control values on
 //! the original edges give optimal leg vectors along the edge loops, and the
-//! spring energy (14) is minimised by nonlinear conjugate gradient (argmin)
-//! with some vertices fixed, on the mesh pre-scaled to the unit cube.
+//! spring energy (14) is minimised with some vertices fixed, on the mesh
+//! pre-scaled to the unit cube, by Levenberg-Marquardt
+//! (`surface_gauss_newton`) or, with [`FinetuneMethod::NonlinearCg`], by
+//! argmin's nonlinear conjugate gradient (`surface_solve`).
 
 use std::time::Instant;
 
