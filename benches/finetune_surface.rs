@@ -57,40 +57,21 @@ fn fine_tuning(c: &mut Criterion) {
 
     let mut group = c.benchmark_group("finetune_surface_torus_1000_edges");
     group.sample_size(10);
-    for (name, p) in [
-        ("end_to_end_lm", &params),
-        ("end_to_end_ncg_200_iters", &ncg),
-    ] {
-        group.bench_function(name, |b| {
-            b.iter(|| {
-                let p = SurfaceFineTune::new(
-                    black_box(&mesh),
-                    SurfaceScheme::DooSabin,
-                    &values,
-                    &fixed,
-                    p,
-                )
-                .expect("precompute");
-                p.solve().expect("solve")
-            })
-        });
-    }
     let cube = subdyn::examples::cube();
     let cube_values = [(7, 3, 1.3), (7, 5, 1.3), (7, 6, 1.3)];
-    for (name, p) in [
-        ("cube_converged_lm", &params),
-        ("cube_converged_ncg", &ncg_full),
+    let cube_fixed = [0, 1, 4];
+    let torus_case = (&mesh, &values[..], &fixed[..]);
+    let cube_case = (&cube, &cube_values[..], &cube_fixed[..]);
+    for (name, (m, v, f), p) in [
+        ("end_to_end_lm", torus_case, &params),
+        ("end_to_end_ncg_200_iters", torus_case, &ncg),
+        ("cube_converged_lm", cube_case, &params),
+        ("cube_converged_ncg", cube_case, &ncg_full),
     ] {
         group.bench_function(name, |b| {
             b.iter(|| {
-                let p = SurfaceFineTune::new(
-                    black_box(&cube),
-                    SurfaceScheme::DooSabin,
-                    &cube_values,
-                    &[0, 1, 4],
-                    p,
-                )
-                .expect("precompute");
+                let p = SurfaceFineTune::new(black_box(m), SurfaceScheme::DooSabin, v, f, p)
+                    .expect("precompute");
                 p.solve().expect("solve")
             })
         });

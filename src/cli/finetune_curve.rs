@@ -9,8 +9,8 @@ use clap::Args;
 use serde_json::json;
 
 use subdyn::finetune::{
-    CurveFinetune, CurveFinetuneParams, CurveLayer, FinetuneMethod, curve_json, curve_picture,
-    read_alpha, read_curve, write_json,
+    CurveFinetune, CurveFinetuneParams, FinetuneMethod, comparison_layers, curve_json,
+    curve_picture, read_alpha, read_curve, write_json,
 };
 use subdyn::math::Real;
 use subdyn::render::{check_png_path, write_png};
@@ -126,34 +126,7 @@ pub fn run(args: &CurveArgs) -> anyhow::Result<()> {
         )?;
     }
     if let Some(path) = &args.png {
-        let spans = topo.num_spans();
-        let ts: Vec<Real> = (0..=20 * spans).map(|i| i as Real / 20.0).collect();
-        let original = topo.limit_stencil(&ts, 0)?.apply(&points)?;
-        let mut polygon = points.clone();
-        if topo.closed {
-            polygon.push(points[0]);
-        }
-        let (t0, t1) = curve.domain();
-        let layers = [
-            CurveLayer {
-                points: polygon,
-                color: [170, 170, 170],
-                width: 1,
-                marks: true,
-            },
-            CurveLayer {
-                points: original,
-                color: [60, 90, 200],
-                width: 3,
-                marks: false,
-            },
-            CurveLayer {
-                points: curve.samples(((t1 - t0) * 20.0).ceil() as usize),
-                color: [220, 60, 40],
-                width: 3,
-                marks: false,
-            },
-        ];
+        let layers = comparison_layers(&topo, &points, &curve)?;
         let picture = curve_picture(&layers, "blue: original  red: fine-tuned", 800, 600)?;
         write_png(path, &picture)?;
     }

@@ -48,7 +48,7 @@ pub use curve_exact::{
     ExactFinetune, closed_spline, exact_finetune, finetuned_spans, spline_from_spans,
 };
 pub use curve_io::{curve_json, read_alpha, read_curve, write_json};
-pub use curve_picture::{CurveLayer, curve_picture};
+pub use curve_picture::{CurveLayer, comparison_layers, curve_layer, curve_picture};
 pub use edge_loops::{EdgeLoop, edge_loops};
 pub use levenberg_marquardt::{
     FinetuneMethod, LeastSquares, LmParams, LmRun, Residuals, levenberg_marquardt,
