@@ -10,6 +10,7 @@ use std::f64::consts::TAU;
 
 use common::Rng;
 use nalgebra::{DMatrix, DVector};
+
 use subdyn::finetune::{
     CholeskyPattern, CurveFinetune, CurveFinetuneParams, FinetuneMethod, LeastSquares, LmParams,
     Residuals, alpha_from_values, levenberg_marquardt,
@@ -17,12 +18,17 @@ use subdyn::finetune::{
 use subdyn::math::Point3;
 use subdyn::subdivision::{CurveScheme, CurveTopology};
 
-/// A random sparse SPD matrix `Σ_g v_g v_gᵀ + I` over random groups of
-/// unknowns, its groups, and the value array in the pattern's slots.
-fn random_system(rng: &mut Rng, n: usize, node_of: &[usize]) -> (DMatrix<f64>, Vec<f64>) {
-    let groups: Vec<Vec<usize>> = (0..2 * n)
+/// Random groups of three unknowns.
+fn random_groups(rng: &mut Rng, n: usize) -> Vec<Vec<usize>> {
+    (0..2 * n)
         .map(|_| (0..3).map(|_| rng.below(n)).collect())
-        .collect();
+        .collect()
+}
+
+/// Checks the factor of the random sparse SPD matrix `Σ_g v_g v_gᵀ + I`
+/// over `groups` against a dense product, and that a negative diagonal is
+/// refused.
+fn random_system(rng: &mut Rng, n: usize, node_of: &[usize], groups: &[Vec<usize>]) {
     let weights: Vec<Vec<f64>> = groups
         .iter()
         .map(|g| g.iter().map(|_| rng.uniform(-1.0, 1.0)).collect())
@@ -60,7 +66,6 @@ fn random_system(rng: &mut Rng, n: usize, node_of: &[usize]) -> (DMatrix<f64>, V
     let mut bad = values.clone();
     bad[slots[s]] -= 1e6;
     assert!(pattern.factor(&bad).is_none());
-    (dense, values)
 }
 
 #[test]
@@ -70,12 +75,40 @@ fn sparse_cholesky_solves_random_spd_systems() {
         // One unknown per node, nodes of 2, of 3 and of 5 (split into 3 + 2).
         for size in [1, 2, 3, 5] {
             let node_of: Vec<usize> = (0..n).map(|i| i / size).collect();
-            random_system(&mut rng, n, &node_of);
+            let groups = random_groups(&mut rng, n);
+            random_system(&mut rng, n, &node_of, &groups);
         }
         // Nodes in scrambled order.
         let node_of: Vec<usize> = (0..n).map(|i| (i * 7) % 5).collect();
-        random_system(&mut rng, n, &node_of);
+        let groups = random_groups(&mut rng, n);
+        random_system(&mut rng, n, &node_of, &groups);
     }
+}
+
+#[test]
+fn sparse_cholesky_solves_a_grid_system_ordered_by_nested_dissection() {
+    // A 30 × 20 grid of 2-unknown nodes coupled to their right and upper
+    // neighbours, plus a ring joining the first column to the last (deep
+    // enough for several levels of dissection, with a cycle).
+    let (w, h) = (30, 20);
+    let node = |i: usize, j: usize| (i % w) * h + j;
+    let n = 2 * w * h;
+    let node_of: Vec<usize> = (0..n).map(|k| k / 2).collect();
+    let mut rng = Rng::new(5);
+    let mut groups = Vec::new();
+    for i in 0..w {
+        for j in 0..h {
+            let a = node(i, j);
+            let mut near = vec![node(i + 1, j)];
+            if j + 1 < h {
+                near.push(node(i, j + 1));
+            }
+            for b in near {
+                groups.push(vec![2 * a, 2 * a + 1, 2 * b, 2 * b + 1]);
+            }
+        }
+    }
+    random_system(&mut rng, n, &node_of, &groups);
 }
 
 /// `r = (z_0 − 1, 10 (z_1 − z_0²), z_2 − z_1)`: Rosenbrock plus a chain, minimum 0 at (1, 1, 1).

@@ -32,6 +32,7 @@ mod curve_solver;
 mod edge_loops;
 mod levenberg_marquardt;
 mod min_degree;
+mod nested_dissection;
 mod sparse_cholesky;
 mod surface;
 mod surface_energy;

@@ -4,8 +4,12 @@
 //!
 //! Up-looking algorithm (Davis, *Direct Methods for Sparse Linear Systems*,
 //! 2006, §4.2 and §4.6: elimination tree, row patterns by `ereach`) on the
-//! graph of nodes (a point's unknowns), with a minimum-degree ordering
-//! (`min_degree`). Every node is a block of 3 unknowns (nodes with fewer get
+//! graph of nodes (a point's unknowns), with a nested-dissection ordering
+//! (`nested_dissection`, minimum degree on small parts). On the benchmark
+//! torus (1,900 nodes) building the pattern took 20–37 ms with nested
+//! dissection against 85–177 ms with minimum degree on the whole graph (a
+//! loaded 2-core machine), with 105,041 factor blocks against 116,058.
+//! Every node is a block of 3 unknowns (nodes with fewer get
 //! unit-diagonal padding, nodes with more are split), so the inner loops are
 //! 3 × 3 matrix products: `Z_i = L_ii⁻¹ X_i`, `X_r −= L_ri Z_i`,
 //! `D −= Z_iᵀ Z_i`, `L_ki = Z_iᵀ`, `L_kk = chol(D)`. Written here rather than
@@ -21,7 +25,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::math::Real;
 
-use super::min_degree::min_degree;
+use super::nested_dissection::nested_dissection;
 
 /// Ordering, block pattern of `P A Pᵀ` (upper triangle by block columns) and
 /// symbolic factor of a sparse symmetric matrix.
@@ -55,7 +59,7 @@ pub struct Cholesky<'a> {
 impl CholeskyPattern {
     /// The pattern of an `n × n` matrix assembled from `groups` (each a list
     /// of unknowns whose every pair is an entry; repeats allowed) and the
-    /// diagonal, ordered by minimum degree of the graph on `node_of[i]`
+    /// diagonal, ordered by nested dissection of the graph on `node_of[i]`
     /// (unknowns of one node form one block). Returns the pattern and the
     /// slots in the value array: for each group, its pairs `(p, q)` with
     /// `p ≤ q` (positions in the group) in order, then the diagonal of
@@ -96,7 +100,7 @@ impl CholeskyPattern {
             a.sort_unstable();
             a.dedup();
         }
-        let order = min_degree(&adj);
+        let order = nested_dissection(&adj);
         let mut rank = vec![0; nb];
         for (r, &b) in order.iter().enumerate() {
             rank[b] = r;
