@@ -195,6 +195,10 @@ pub fn levenberg_marquardt<P: LeastSquares>(problem: &P, z0: &[Real], params: &L
             let mut s = first_slot;
             e += r * r;
             let (vars, grads) = (&rows.vars[range.clone()], &rows.grads[range]);
+            if r == 0.0 && grads.iter().all(|&x| x == 0.0) {
+                // An unused curvature row: nothing to add.
+                continue;
+            }
             for (p, (&a, &ga)) in vars.iter().zip(grads).enumerate() {
                 g[a] += 2.0 * r * ga;
                 for (q, (&b, &gb)) in vars.iter().zip(grads).enumerate().skip(p) {
