@@ -13,7 +13,8 @@
 use std::path::Path;
 
 use subdyn::finetune::{
-    CurveFinetune, CurveFinetuneParams, CurveLayer, alpha_from_values, curve_picture,
+    CurveFinetune, CurveFinetuneParams, alpha_from_values, comparison_layers, curve_layer,
+    curve_picture,
 };
 use subdyn::math::Point3;
 use subdyn::render::write_png;
@@ -45,7 +46,7 @@ fn main() -> subdyn::Result<()> {
     let tuner = CurveFinetune::new(&topo, &polygon, &alpha, &params)?;
     let (curve, report) = tuner.solve()?;
     println!(
-        "degree {} (knot multiplicity {}), {} control points; {} NCG iterations ({}), energy {:.3e} -> {:.3e}; gap {:.3} -> {:.1e}; {:.1} ms",
+        "degree {} (knot multiplicity {}), {} control points; {} Levenberg-Marquardt iterations ({}), energy {:.3e} -> {:.3e}; gap {:.3} -> {:.1e}; {:.1} ms",
         report.degree,
         report.multiplicity,
         report.num_control_points,
@@ -57,38 +58,8 @@ fn main() -> subdyn::Result<()> {
         report.gap_after,
         report.seconds * 1e3
     );
-    let ts: Vec<f64> = (0..=20 * polygon.len()).map(|i| i as f64 / 20.0).collect();
-    let original = topo.limit_stencil(&ts, 0)?.apply(&polygon)?;
-    let mut closed_polygon = polygon.clone();
-    closed_polygon.push(polygon[0]);
-    let unclosed = tuner.exact().curve.samples(20 * polygon.len());
-    let tuned = curve.samples(20 * polygon.len());
-    let layers = [
-        CurveLayer {
-            points: closed_polygon,
-            color: [170, 170, 170],
-            width: 1,
-            marks: true,
-        },
-        CurveLayer {
-            points: unclosed,
-            color: [40, 170, 60],
-            width: 1,
-            marks: false,
-        },
-        CurveLayer {
-            points: original,
-            color: [60, 90, 200],
-            width: 3,
-            marks: false,
-        },
-        CurveLayer {
-            points: tuned,
-            color: [220, 60, 40],
-            width: 3,
-            marks: false,
-        },
-    ];
+    let mut layers = comparison_layers(&topo, &polygon, &curve)?;
+    layers.insert(1, curve_layer(&tuner.exact().curve, [40, 170, 60], 1));
     let picture = curve_picture(
         &layers,
         "bottom leg x1.5: blue original, red fine-tuned, green unclosed",

@@ -11,7 +11,7 @@
 
 use std::path::Path;
 
-use subdyn::finetune::{CurveLayer, alpha_from_values, curve_picture, exact_finetune};
+use subdyn::finetune::{alpha_from_values, comparison_layers, curve_picture, exact_finetune};
 use subdyn::math::Point3;
 use subdyn::render::write_png;
 use subdyn::subdivision::{CurveScheme, CurveTopology};
@@ -42,30 +42,7 @@ fn main() -> subdyn::Result<()> {
         exact.multiplicity,
         exact.curve.control_points.len()
     );
-    let ts: Vec<f64> = (0..=20 * topo.num_spans())
-        .map(|i| i as f64 / 20.0)
-        .collect();
-    let original = topo.limit_stencil(&ts, 0)?.apply(&polygon)?;
-    let layers = [
-        CurveLayer {
-            points: polygon,
-            color: [170, 170, 170],
-            width: 1,
-            marks: true,
-        },
-        CurveLayer {
-            points: original,
-            color: [60, 90, 200],
-            width: 3,
-            marks: false,
-        },
-        CurveLayer {
-            points: exact.curve.samples(ts.len()),
-            color: [220, 60, 40],
-            width: 3,
-            marks: false,
-        },
-    ];
+    let layers = comparison_layers(&topo, &polygon, &exact.curve)?;
     let picture = curve_picture(
         &layers,
         "alpha 0.6 -> 1.6: blue original, red fine-tuned",

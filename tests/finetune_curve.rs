@@ -406,16 +406,7 @@ fn bad_input_is_one_clear_error() {
 // The `subdyn finetune curve` verb.
 
 mod cli {
-    use std::path::Path;
-    use std::process::{Command, Output};
-
-    fn subdyn(dir: &Path, args: &[&str]) -> Output {
-        Command::new(env!("CARGO_BIN_EXE_subdyn"))
-            .args(args)
-            .current_dir(dir)
-            .output()
-            .expect("the subdyn binary runs")
-    }
+    use super::common::run_subdyn as subdyn;
 
     const OCTAGON: &str = r#"{"scheme": "quadratic", "closed": true,
         "points": [[0,0],[2,0],[3,1],[3,3],[2,4],[0,4],[-1,3],[-1,1]]}"#;

@@ -3,9 +3,11 @@
 //! with values above 1 get longer; and the `subdyn finetune surface` /
 //! `subdyn subdivide --scheme` command lines with bad inputs.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
+use std::process::Output;
+
+use common::run_subdyn as subdyn;
 use subdyn::finetune::{
     SurfaceFineTune, SurfaceFineTuneParams, SurfaceScheme, doo_sabin_to_non_uniform, edge_loops,
 };
@@ -192,14 +194,6 @@ fn bad_parameters_are_refused() {
 
 // ---------------------------------------------------------------- CLI
 
-fn subdyn(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_subdyn"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
-}
-
 fn fails_with(out: &Output, needle: &str) {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "expected failure, stderr: {err}");
@@ -288,134 +282,32 @@ fn cli_finetune_surface_runs_and_refuses_bad_input() {
     assert!(diff < 1e-5, "refined outputs differ by {diff}");
 
     // Bad inputs: one line, non-zero exit, no output file.
-    std::fs::write(d.join("bad.json"), "{\"edges\": [[7, 3]]}").unwrap();
-    fails_with(
-        &subdyn(
-            d,
-            &[
-                "finetune",
-                "surface",
-                "cube.obj",
-                "--edge-values",
-                "bad.json",
-                "-o",
-                "x.obj",
-            ],
-        ),
-        "bad.json",
-    );
-    std::fs::write(d.join("bad2.json"), "{\"edges\": [[0, 7, 1.3]]}").unwrap();
-    fails_with(
-        &subdyn(
-            d,
-            &[
-                "finetune",
-                "surface",
-                "cube.obj",
-                "--edge-values",
-                "bad2.json",
-                "-o",
-                "x.obj",
-            ],
-        ),
-        "not joined",
-    );
-    std::fs::write(d.join("bad3.json"), "not json").unwrap();
-    fails_with(
-        &subdyn(
-            d,
-            &[
-                "finetune",
-                "surface",
-                "cube.obj",
-                "--edge-values",
-                "bad3.json",
-                "-o",
-                "x.obj",
-            ],
-        ),
-        "JSON",
-    );
-    std::fs::write(d.join("bad4.json"), "{\"default\": -2}").unwrap();
-    fails_with(
-        &subdyn(
-            d,
-            &[
-                "finetune",
-                "surface",
-                "cube.obj",
-                "--edge-values",
-                "bad4.json",
-                "-o",
-                "x.obj",
-            ],
-        ),
-        "control value",
-    );
-    fails_with(
-        &subdyn(
-            d,
-            &[
-                "finetune",
-                "surface",
-                "cube.obj",
-                "--edge-values",
-                "v.json",
-                "--fix",
-                "99",
-                "-o",
-                "x.obj",
-            ],
-        ),
-        "fixed vertex 99",
-    );
-    fails_with(
-        &subdyn(
-            d,
-            &[
-                "finetune",
-                "surface",
-                "cube.obj",
-                "--edge-values",
-                "v.json",
-                "--k",
-                "1,1",
-                "-o",
-                "x.obj",
-            ],
-        ),
-        "three values",
-    );
-    fails_with(
-        &subdyn(
-            d,
-            &[
-                "finetune",
-                "surface",
-                "cube.obj",
-                "--edge-values",
-                "v.json",
-                "-o",
-                "x.txt",
-            ],
-        ),
-        "x.txt",
-    );
-    fails_with(
-        &subdyn(
-            d,
-            &[
-                "finetune",
-                "surface",
-                "missing.obj",
-                "--edge-values",
-                "v.json",
-                "-o",
-                "x.obj",
-            ],
-        ),
-        "missing.obj",
-    );
+    for (name, text) in [
+        ("bad.json", r#"{"edges": [[7, 3]]}"#),
+        ("bad2.json", r#"{"edges": [[0, 7, 1.3]]}"#),
+        ("bad3.json", "not json"),
+        ("bad4.json", r#"{"default": -2}"#),
+    ] {
+        std::fs::write(d.join(name), text).unwrap();
+    }
+    let cases: [(&str, &str, &[&str], &str); 8] = [
+        ("cube.obj", "bad.json", &[], "bad.json"),
+        ("cube.obj", "bad2.json", &[], "not joined"),
+        ("cube.obj", "bad3.json", &[], "JSON"),
+        ("cube.obj", "bad4.json", &[], "control value"),
+        ("cube.obj", "v.json", &["--fix", "99"], "fixed vertex 99"),
+        ("cube.obj", "v.json", &["--k", "1,1"], "three values"),
+        ("cube.obj", "v.json", &["-o", "x.txt"], "x.txt"),
+        ("missing.obj", "v.json", &[], "missing.obj"),
+    ];
+    for (mesh, values, extra, needle) in cases {
+        let mut args = vec!["finetune", "surface", mesh, "--edge-values", values];
+        args.extend_from_slice(extra);
+        if !extra.contains(&"-o") {
+            args.extend_from_slice(&["-o", "x.obj"]);
+        }
+        fails_with(&subdyn(d, &args), needle);
+    }
     assert!(!d.join("x.obj").exists());
 }
 

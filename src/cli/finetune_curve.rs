@@ -9,8 +9,8 @@ use clap::Args;
 use serde_json::json;
 
 use subdyn::finetune::{
-    CurveFinetune, CurveFinetuneParams, CurveLayer, curve_json, curve_picture, read_alpha,
-    read_curve, write_json,
+    CurveFinetune, CurveFinetuneParams, FinetuneMethod, comparison_layers, curve_json,
+    curve_picture, read_alpha, read_curve, write_json,
 };
 use subdyn::math::Real;
 use subdyn::render::{check_png_path, write_png};
@@ -41,6 +41,9 @@ pub struct CurveArgs {
     /// Index of the fixed control point of the fine-tuned polygon (closed curves).
     #[arg(long, value_name = "I", default_value_t = 0)]
     pub fix: usize,
+    /// Minimiser of energy (13): lm (Levenberg-Marquardt) or ncg (argmin's nonlinear CG).
+    #[arg(long, value_name = "lm|ncg", default_value = "lm")]
+    pub method: FinetuneMethod,
     /// Write a JSON report (energies, iterations, gaps, time).
     #[arg(long, value_name = "R.json")]
     pub report: Option<PathBuf>,
@@ -81,6 +84,7 @@ pub fn run(args: &CurveArgs) -> anyhow::Result<()> {
         k_length,
         k_angle,
         fixed_point: args.fix,
+        method: args.method,
         ..CurveFinetuneParams::default()
     };
     let tuner = CurveFinetune::new(&topo, &points, &alpha, &params)?;
@@ -107,6 +111,7 @@ pub fn run(args: &CurveArgs) -> anyhow::Result<()> {
                 "multiplicity": report.multiplicity,
                 "control_points": report.num_control_points,
                 "variables": report.num_variables,
+                "method": format!("{:?}", args.method),
                 "iterations": report.iterations,
                 "initial_energy": report.initial_energy,
                 "final_energy": report.final_energy,
@@ -121,34 +126,7 @@ pub fn run(args: &CurveArgs) -> anyhow::Result<()> {
         )?;
     }
     if let Some(path) = &args.png {
-        let spans = topo.num_spans();
-        let ts: Vec<Real> = (0..=20 * spans).map(|i| i as Real / 20.0).collect();
-        let original = topo.limit_stencil(&ts, 0)?.apply(&points)?;
-        let mut polygon = points.clone();
-        if topo.closed {
-            polygon.push(points[0]);
-        }
-        let (t0, t1) = curve.domain();
-        let layers = [
-            CurveLayer {
-                points: polygon,
-                color: [170, 170, 170],
-                width: 1,
-                marks: true,
-            },
-            CurveLayer {
-                points: original,
-                color: [60, 90, 200],
-                width: 3,
-                marks: false,
-            },
-            CurveLayer {
-                points: curve.samples(((t1 - t0) * 20.0).ceil() as usize),
-                color: [220, 60, 40],
-                width: 3,
-                marks: false,
-            },
-        ];
+        let layers = comparison_layers(&topo, &points, &curve)?;
         let picture = curve_picture(&layers, "blue: original  red: fine-tuned", 800, 600)?;
         write_png(path, &picture)?;
     }

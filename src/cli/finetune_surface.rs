@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use clap::{Args, ValueEnum};
 use serde_json::{Value, json};
 
-use subdyn::finetune::{SurfaceFineTune, SurfaceFineTuneParams, SurfaceScheme};
+use subdyn::finetune::{FinetuneMethod, SurfaceFineTune, SurfaceFineTuneParams, SurfaceScheme};
 use subdyn::io::{atomic_write, write_mesh};
 use subdyn::math::Real;
 use subdyn::subdivision::NonUniformHierarchy;
@@ -49,9 +49,12 @@ pub struct SurfaceArgs {
     /// Knot interval in place of 0 on converted face edges (Doo-Sabin input).
     #[arg(long, default_value_t = 0.05)]
     pub epsilon: Real,
-    /// Most conjugate-gradient iterations.
+    /// Most iterations of the minimiser.
     #[arg(long, default_value_t = 2000)]
     pub max_iters: u64,
+    /// Minimiser of energy (14): lm (Levenberg-Marquardt) or ncg (argmin's nonlinear CG).
+    #[arg(long, value_name = "lm|ncg", default_value = "lm")]
+    pub method: FinetuneMethod,
     /// Output: the fine-tuned (non-uniform Catmull-Clark) control mesh.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
@@ -146,6 +149,7 @@ pub fn run(args: &SurfaceArgs) -> anyhow::Result<()> {
         k: [k_l, k_a, k_b],
         epsilon: args.epsilon,
         max_iters: args.max_iters,
+        method: args.method,
         ..Default::default()
     };
     let scheme = match args.scheme {

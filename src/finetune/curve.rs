@@ -7,7 +7,9 @@
 //! the same degree `D` and knot multiplicity `m`); the optimal lengths and
 //! angles are those of the unclosed exact `Q`; the curve is pre-scaled to fit
 //! the unit square (cube) and scaled back; one control point and one rotation
-//! are fixed; energy (13) is minimised by nonlinear conjugate gradient. The
+//! are fixed; energy (13) is minimised by Levenberg-Marquardt on its sparse
+//! Gauss-Newton matrix (`curve_gauss_newton`; argmin's nonlinear conjugate
+//! gradient, which issue 8 named, is [`FinetuneMethod::NonlinearCg`]). The
 //! result is a periodic B-spline, so it closes by construction; `α ≡ 1` has
 //! zero energy and zero gradient at the start and returns `P` unchanged.
 //!
@@ -45,7 +47,9 @@ use super::curve_bspline::BSplineCurve;
 use super::curve_energy::SpringTargets;
 use super::curve_exact::{ExactFinetune, closed_spline, exact_finetune};
 use super::curve_frames::leg_frames;
+use super::curve_gauss_newton::CurvePointProblem;
 use super::curve_solver::{Converging, History, STALLED, SpringProblem};
+use super::levenberg_marquardt::{FinetuneMethod, LeastSquares, LmParams, levenberg_marquardt};
 
 /// Parameters of closed-curve fine tuning.
 #[derive(Clone, Debug, PartialEq)]
@@ -62,6 +66,9 @@ pub struct CurveFinetuneParams {
     pub gradient_tolerance: Real,
     /// Iteration limit. Default 50 000.
     pub max_iterations: u64,
+    /// The minimiser. Default Levenberg-Marquardt (`levenberg_marquardt`);
+    /// [`FinetuneMethod::NonlinearCg`] is argmin's nonlinear CG.
+    pub method: FinetuneMethod,
 }
 
 impl Default for CurveFinetuneParams {
@@ -72,6 +79,7 @@ impl Default for CurveFinetuneParams {
             fixed_point: 0,
             gradient_tolerance: 1e-9,
             max_iterations: 50_000,
+            method: FinetuneMethod::default(),
         }
     }
 }
@@ -87,7 +95,7 @@ pub struct CurveFinetuneReport {
     pub num_control_points: usize,
     /// Optimisation variables (0 for an open curve).
     pub num_variables: usize,
-    /// NCG iterations (0 for an open curve).
+    /// Iterations of the minimiser (0 for an open curve).
     pub iterations: usize,
     /// Energy (13) at the start and after every iteration (unit-square scaling).
     pub energies: Vec<Real>,
@@ -241,6 +249,48 @@ impl CurveFinetune {
             report.seconds = start_time.elapsed().as_secs_f64();
             return Ok((self.exact.curve.clone(), report));
         };
+        let (x, energies, termination) = match self.params.method {
+            FinetuneMethod::NonlinearCg => self.ncg(setup)?,
+            FinetuneMethod::LevenbergMarquardt => {
+                let points = CurvePointProblem::new(&setup.problem, &setup.start);
+                let lm = LmParams {
+                    gradient_tolerance: self.params.gradient_tolerance,
+                    max_iterations: self.params.max_iterations,
+                    stall_window: 0,
+                    stall_relative: 0.0,
+                };
+                let run = levenberg_marquardt(&points, &vec![0.0; points.num_vars()], &lm);
+                let x = setup.problem.variables(&points.points(&run.z));
+                (x, run.energies, run.termination)
+            }
+        };
+        let (energy, gradient) = setup.problem.energy_gradient(&x);
+        let points: Vec<Point3> = setup
+            .problem
+            .points(&x)
+            .iter()
+            .map(|p| setup.lo + p.coords / setup.scale)
+            .collect();
+        let curve = closed_spline(&points, self.exact.degree, self.exact.multiplicity)?;
+        let (t0, t1) = curve.domain();
+        report.num_control_points = points.len();
+        report.num_variables = x.len();
+        report.iterations = energies.len().saturating_sub(1);
+        report.initial_energy = energies.first().copied().unwrap_or(energy);
+        report.energies = energies;
+        report.final_energy = energy;
+        report.gradient_norm = gradient.iter().map(|g| g * g).sum::<Real>().sqrt();
+        report.converged =
+            report.gradient_norm <= self.params.gradient_tolerance || termination == STALLED;
+        report.termination = termination;
+        report.gap_after = (curve.point(t1) - curve.point(t0)).norm() / self.size;
+        report.seconds = start_time.elapsed().as_secs_f64();
+        Ok((curve, report))
+    }
+
+    /// argmin's nonlinear CG from the start: the variables reached, the
+    /// energies and why it stopped.
+    fn ncg(&self, setup: &ClosedSetup) -> Result<(Vec<Real>, Vec<Real>, String)> {
         let history = Arc::new(Mutex::new(History::default()));
         // Strong Wolfe with c2 = 0.1 keeps PR+ directions descent directions
         // (c2 = 0.9 fails within a few iterations); PR+ restarts by itself,
@@ -279,28 +329,7 @@ impl CurveFinetune {
             Err(_) => h.last.clone(),
         }
         .map_or_else(|| setup.start.clone(), |x| x.as_slice().to_vec());
-        let (energy, gradient) = setup.problem.energy_gradient(&x);
-        let points: Vec<Point3> = setup
-            .problem
-            .points(&x)
-            .iter()
-            .map(|p| setup.lo + p.coords / setup.scale)
-            .collect();
-        let curve = closed_spline(&points, self.exact.degree, self.exact.multiplicity)?;
-        let (t0, t1) = curve.domain();
-        report.num_control_points = points.len();
-        report.num_variables = x.len();
-        report.iterations = h.energies.len().saturating_sub(1);
-        report.energies = h.energies.clone();
-        report.initial_energy = h.energies.first().copied().unwrap_or(energy);
-        report.final_energy = energy;
-        report.gradient_norm = gradient.iter().map(|g| g * g).sum::<Real>().sqrt();
-        report.converged =
-            report.gradient_norm <= self.params.gradient_tolerance || termination == STALLED;
-        report.termination = termination;
-        report.gap_after = (curve.point(t1) - curve.point(t0)).norm() / self.size;
-        report.seconds = start_time.elapsed().as_secs_f64();
-        Ok((curve, report))
+        Ok((x, h.energies.clone(), termination))
     }
 
     /// The curve's topology.

@@ -53,8 +53,34 @@ pub fn joint_angle(a: &Vector3, b: &Vector3, planar: bool) -> Real {
     }
 }
 
+/// `(∂θ/∂a, ∂θ/∂b)` of [`joint_angle`] `θ` of legs `a`, `b` (zero for a
+/// vanishing leg; in 3-D also where `sin θ < 1e-9`, see the module docs).
+pub fn joint_angle_gradients(
+    a: &Vector3,
+    b: &Vector3,
+    theta: Real,
+    planar: bool,
+) -> (Vector3, Vector3) {
+    let (la, lb) = (a.norm(), b.norm());
+    if la <= TINY || lb <= TINY {
+        return (Vector3::zeros(), Vector3::zeros());
+    }
+    if planar {
+        (
+            Vector3::new(a.y, -a.x, 0.0) / (la * la),
+            Vector3::new(-b.y, b.x, 0.0) / (lb * lb),
+        )
+    } else {
+        let (ua, ub) = (a / la, b / lb);
+        let (s, c) = (theta.sin(), theta.cos());
+        // ∂θ/∂a · (θ − θ_opt) = −(b̂ − cos θ â)/|a| · (θ − θ_opt)/sin θ
+        let ratio = if s > 1e-9 { 1.0 / s } else { 0.0 };
+        (-(ub - c * ua) * ratio / la, -(ua - c * ub) * ratio / lb)
+    }
+}
+
 /// `x` wrapped into `(−π, π]`.
-fn wrap(x: Real) -> Real {
+pub fn wrap_angle(x: Real) -> Real {
     let y = x.rem_euclid(TAU);
     if y > PI { y - TAU } else { y }
 }
@@ -89,9 +115,8 @@ impl SpringTargets {
             let dl = lb - self.lengths[i];
             e += self.k_length * dl * dl;
             let a = leg((i + m - 1) % m);
-            let la = a.norm();
             let theta = joint_angle(&a, &b, self.planar);
-            let da = wrap(theta - self.angles[i]);
+            let da = wrap_angle(theta - self.angles[i]);
             e += self.k_angle * da * da;
             let Some(g) = gradient.as_deref_mut() else {
                 continue;
@@ -101,21 +126,7 @@ impl SpringTargets {
                 g[(i + 1) % m] += f;
                 g[i] -= f;
             }
-            if la <= TINY || lb <= TINY {
-                continue;
-            }
-            let (ga, gb) = if self.planar {
-                (
-                    Vector3::new(a.y, -a.x, 0.0) / (la * la),
-                    Vector3::new(-b.y, b.x, 0.0) / (lb * lb),
-                )
-            } else {
-                let (ua, ub) = (a / la, b / lb);
-                let (s, c) = (theta.sin(), theta.cos());
-                // ∂θ/∂a · (θ − θ_opt) = −(b̂ − cos θ â)/|a| · (θ − θ_opt)/sin θ
-                let ratio = if s > 1e-9 { 1.0 / s } else { 0.0 };
-                (-(ub - c * ua) * ratio / la, -(ua - c * ub) * ratio / lb)
-            };
+            let (ga, gb) = joint_angle_gradients(&a, &b, theta, self.planar);
             let w = 2.0 * self.k_angle * da;
             g[i] += w * ga;
             g[(i + m - 1) % m] -= w * ga;

@@ -4,6 +4,12 @@
 use crate::error::{Error, Result};
 use crate::math::{Point3, Real};
 use crate::render::{Picture, Rgb, draw_text};
+use crate::subdivision::CurveTopology;
+
+use super::curve_bspline::BSplineCurve;
+
+/// Samples per parameter unit (span) of the drawn curves.
+const SAMPLES_PER_SPAN: Real = 20.0;
 
 /// One polyline to draw: points (z ignored), colour, line width in pixels,
 /// and whether to mark each point with a small square.
@@ -17,6 +23,49 @@ pub struct CurveLayer {
     pub width: u32,
     /// Draw a 5×5 square on every point.
     pub marks: bool,
+}
+
+/// `curve` sampled at 20 points per span, drawn without marks.
+pub fn curve_layer(curve: &BSplineCurve, color: Rgb, width: u32) -> CurveLayer {
+    let (t0, t1) = curve.domain();
+    CurveLayer {
+        points: curve.samples(((t1 - t0) * SAMPLES_PER_SPAN).ceil().max(1.0) as usize),
+        color,
+        width,
+        marks: false,
+    }
+}
+
+/// The layers of a before/after picture: the control polygon `polygon`
+/// (grey, marked, closed for a closed curve), its limit curve (blue) and
+/// `tuned` (red).
+pub fn comparison_layers(
+    topology: &CurveTopology,
+    polygon: &[Point3],
+    tuned: &BSplineCurve,
+) -> Result<Vec<CurveLayer>> {
+    let steps = (SAMPLES_PER_SPAN as usize) * topology.num_spans();
+    let ts: Vec<Real> = (0..=steps).map(|i| i as Real / SAMPLES_PER_SPAN).collect();
+    let original = topology.limit_stencil(&ts, 0)?.apply(polygon)?;
+    let mut points = polygon.to_vec();
+    if topology.closed && !polygon.is_empty() {
+        points.push(polygon[0]);
+    }
+    Ok(vec![
+        CurveLayer {
+            points,
+            color: [170, 170, 170],
+            width: 1,
+            marks: true,
+        },
+        CurveLayer {
+            points: original,
+            color: [60, 90, 200],
+            width: 3,
+            marks: false,
+        },
+        curve_layer(tuned, [220, 60, 40], 3),
+    ])
 }
 
 /// Draws `layers` into a `width × height` white picture with a 5 % margin

@@ -60,6 +60,20 @@ impl SpringProblem {
         out
     }
 
+    /// The variables that reproduce `points` (which must satisfy the gauge:
+    /// `points[fixed] = origin`, every leg in the span of its axes).
+    pub fn variables(&self, points: &[Point3]) -> Vec<Real> {
+        let n = points.len();
+        let mut x = vec![0.0; self.num_vars];
+        for (t, leg) in self.legs.iter().enumerate() {
+            let d = points[(self.fixed + t + 1) % n] - points[(self.fixed + t) % n];
+            for (v, a) in &leg.axes {
+                x[*v] = d.dot(a) / a.norm_squared();
+            }
+        }
+        x
+    }
+
     /// Energy and gradient in the variables: `∂E/∂d_t = Σ_{s>t} ∂E/∂p_s`.
     pub fn energy_gradient(&self, x: &[Real]) -> (Real, Vec<Real>) {
         let points = self.points(x);

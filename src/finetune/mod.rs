@@ -2,17 +2,22 @@
 //! (fine-tuning paper, §4.2–4.4).
 //!
 //! Curves: a new curve `Q` with `Q'(t) = α(t) P'(t)`, closed curves closed
-//! again by the spring energy (13) minimised with nonlinear CG. Files:
+//! again by the spring energy (13) minimised by Levenberg-Marquardt
+//! (`levenberg_marquardt`, `sparse_cholesky`, `min_degree`,
+//! `angle_curvature`) or argmin's nonlinear CG. Files:
 //! `curve_alpha` (α from control values), `curve_exact` (exact product and
 //! integral as a B-spline), `curve_bspline` (evaluation), `curve_energy`
 //! (eq. 13), `curve_frames` (fixed point and rotation), `curve_solver` (argmin
-//! glue), `curve` (params, precompute, solve, report), `curve_io` (JSON
-//! files), `curve_picture` (top-view PNG).
+//! glue), `curve_gauss_newton` (eq. 13 as residuals), `curve` (params,
+//! precompute, solve, report), `curve_io` (JSON files), `curve_picture`
+//! (top-view PNG).
 //!
 //! Surfaces: Doo-Sabin to non-uniform Catmull-Clark conversion (`convert`),
 //! edge loops, the spring energy (14) (`surface_energy`, `surface_targets`)
-//! minimised by nonlinear conjugate gradient (`surface_solve`, `surface`).
+//! minimised by Levenberg-Marquardt (`surface_gauss_newton`) or nonlinear
+//! conjugate gradient (`surface_solve`, `surface`).
 
+mod angle_curvature;
 mod convert;
 mod curve;
 mod curve_alpha;
@@ -20,12 +25,18 @@ mod curve_bspline;
 mod curve_energy;
 mod curve_exact;
 mod curve_frames;
+mod curve_gauss_newton;
 mod curve_io;
 mod curve_picture;
 mod curve_solver;
 mod edge_loops;
+mod levenberg_marquardt;
+mod min_degree;
+mod nested_dissection;
+mod sparse_cholesky;
 mod surface;
 mod surface_energy;
+mod surface_gauss_newton;
 mod surface_solve;
 mod surface_targets;
 
@@ -33,13 +44,17 @@ pub use convert::{Conversion, ConvertedEdge, conversion_weight, doo_sabin_to_non
 pub use curve::{CurveFinetune, CurveFinetuneParams, CurveFinetuneReport, finetune_curve};
 pub use curve_alpha::{ScalarFunction, ValuesOn, alpha_from_values, values_on};
 pub use curve_bspline::BSplineCurve;
-pub use curve_energy::{SpringTargets, joint_angle};
+pub use curve_energy::{SpringTargets, joint_angle, joint_angle_gradients, wrap_angle};
 pub use curve_exact::{
     ExactFinetune, closed_spline, exact_finetune, finetuned_spans, spline_from_spans,
 };
 pub use curve_io::{curve_json, read_alpha, read_curve, write_json};
-pub use curve_picture::{CurveLayer, curve_picture};
+pub use curve_picture::{CurveLayer, comparison_layers, curve_layer, curve_picture};
 pub use edge_loops::{EdgeLoop, edge_loops};
+pub use levenberg_marquardt::{
+    FinetuneMethod, LeastSquares, LmParams, LmRun, Residuals, levenberg_marquardt,
+};
+pub use sparse_cholesky::{Cholesky, CholeskyPattern};
 pub use surface::{SurfaceFineTune, SurfaceFineTuneParams, SurfaceFineTuneReport, SurfaceScheme};
 pub use surface_energy::{SpringEnergy, angle_and_gradients, joint_angles};
 pub use surface_targets::{LegKind, loop_targets};

@@ -1,8 +1,10 @@
 //! Surface fine tuning (fine-tuning paper, §4.3–4.4): a Doo-Sabin control
 //! mesh is converted to a non-uniform Catmull-Clark mesh, control values on
 //! the original edges give optimal leg vectors along the edge loops, and the
-//! spring energy (14) is minimised by nonlinear conjugate gradient (argmin)
-//! with some vertices fixed, on the mesh pre-scaled to the unit cube.
+//! spring energy (14) is minimised with some vertices fixed, on the mesh
+//! pre-scaled to the unit cube, by Levenberg-Marquardt
+//! (`surface_gauss_newton`) or, with [`FinetuneMethod::NonlinearCg`], by
+//! argmin's nonlinear conjugate gradient (`surface_solve`).
 
 use std::time::Instant;
 
@@ -11,6 +13,7 @@ use crate::math::{Point3, Real, bounding_box};
 use crate::mesh::PolyMesh;
 use crate::topology::{Level, find_edge};
 
+use super::levenberg_marquardt::FinetuneMethod;
 use super::surface_energy::{SpringEnergy, joint_angles};
 use super::surface_solve::minimise;
 use super::surface_targets::{LegKind, loop_targets};
@@ -33,7 +36,7 @@ pub struct SurfaceFineTuneParams {
     pub k: [Real; 3],
     /// Knot interval used in place of 0 in the conversion; default 0.05 (the paper's figure 16).
     pub epsilon: Real,
-    /// Most conjugate-gradient iterations; default 2000.
+    /// Most iterations; default 2000.
     pub max_iters: u64,
     /// Stop when the gradient norm (in the solver's Jacobi-scaled variables) is below this; default 1e-9.
     pub gradient_tolerance: Real,
@@ -42,6 +45,9 @@ pub struct SurfaceFineTuneParams {
     pub energy_tolerance: Real,
     /// Pre-scale the mesh to the unit cube (and scale back); default true.
     pub prescale: bool,
+    /// The minimiser; default Levenberg-Marquardt (`surface_gauss_newton`),
+    /// [`FinetuneMethod::NonlinearCg`] is argmin's nonlinear CG.
+    pub method: FinetuneMethod,
 }
 
 impl Default for SurfaceFineTuneParams {
@@ -53,6 +59,7 @@ impl Default for SurfaceFineTuneParams {
             gradient_tolerance: 1e-9,
             energy_tolerance: 1e-5,
             prescale: true,
+            method: FinetuneMethod::default(),
         }
     }
 }
@@ -60,7 +67,9 @@ impl Default for SurfaceFineTuneParams {
 /// What a fine-tuning run did.
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct SurfaceFineTuneReport {
-    /// Conjugate-gradient iterations.
+    /// The minimiser used.
+    pub method: FinetuneMethod,
+    /// Iterations of the minimiser.
     pub iterations: u64,
     /// Energy before the first iteration and after each one (unit-cube scale).
     pub energies: Vec<Real>,
@@ -244,6 +253,7 @@ impl SurfaceFineTune {
             .map(|(a, b)| (a - b).norm())
             .fold(0.0, Real::max);
         let report = SurfaceFineTuneReport {
+            method: self.params.method,
             iterations: run.iterations,
             energies: run.energies,
             gradient_norms: run.gradient_norms,

@@ -25,7 +25,9 @@ use crate::error::{Error, Result};
 use crate::math::{Point3, Real};
 
 use super::SurfaceFineTuneParams;
+use super::levenberg_marquardt::{FinetuneMethod, LeastSquares, LmParams, levenberg_marquardt};
 use super::surface_energy::SpringEnergy;
+use super::surface_gauss_newton::SurfacePointProblem;
 
 /// Positions and history of one minimisation.
 pub struct Minimised {
@@ -182,6 +184,23 @@ pub fn minimise(
             gradient_norms: Vec::new(),
             iterations: 0,
             termination: "nothing to do".into(),
+        });
+    }
+    if params.method == FinetuneMethod::LevenbergMarquardt {
+        let problem = SurfacePointProblem::new(energy, x0, &free, &scale);
+        let lm = LmParams {
+            gradient_tolerance: params.gradient_tolerance,
+            max_iterations: params.max_iters,
+            stall_window: STALL_WINDOW,
+            stall_relative: params.energy_tolerance,
+        };
+        let run = levenberg_marquardt(&problem, &vec![0.0; problem.num_vars()], &lm);
+        return Ok(Minimised {
+            positions: problem.positions(&run.z),
+            energies: run.energies,
+            gradient_norms: run.gradient_norms,
+            iterations: run.iterations,
+            termination: run.termination,
         });
     }
     let linesearch = MoreThuenteLineSearch::new()
