@@ -781,4 +781,19 @@ fn fit_bad_inputs_are_one_line_errors() {
         &["tol"],
         &["nan.xyz", "sphere.xyz", "three.xyz"],
     );
+    // A missing output directory is reported before any work.
+    for args in [
+        ["-o", "missing/fit.obj", "--report", "r.json"],
+        ["-o", "fit.obj", "--report", "missing/r.json"],
+    ] {
+        let mut all = vec!["fit", "sphere.xyz"];
+        all.extend(args);
+        let out = run_subdyn(dir.path(), &all);
+        assert_clean_failure(
+            dir.path(),
+            &out,
+            &["missing", "does not exist"],
+            &["nan.xyz", "sphere.xyz", "three.xyz"],
+        );
+    }
 }

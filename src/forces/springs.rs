@@ -13,6 +13,7 @@ use crate::error::{Error, Result};
 use crate::limit::{ClosestPoint, ClosestPointEngine};
 use crate::math::{Point3, Real};
 use crate::stencil::StencilTable;
+use rayon::prelude::*;
 
 /// The implicit spring terms over the control points.
 #[derive(Clone, Debug)]
@@ -66,9 +67,12 @@ pub fn spring_system(
     }
     let table = engine.table();
     let s = table.to_level();
-    let mut rows = StencilTable::with_capacity(s.num_rows(), points.len(), 0);
-    for c in closest {
-        let (cols, w) = table.position_stencil(c.patch.0 as usize, c.patch.1);
+    let stencils: Vec<(Vec<u32>, Vec<Real>)> = closest
+        .par_iter()
+        .map(|c| table.position_stencil(c.patch.0 as usize, c.patch.1))
+        .collect();
+    let mut rows = StencilTable::with_capacity(s.num_rows(), points.len(), 16 * points.len());
+    for (cols, w) in stencils {
         rows.push_row(cols.into_iter().zip(w));
     }
     let surface: Vec<Point3> = closest.iter().map(|c| c.point).collect();
