@@ -63,6 +63,10 @@ pub struct FitArgs {
     /// Bending weight λ_b of the thin plate (β = λ_b / area).
     #[arg(long, value_name = "λ", default_value_t = FitParams::default().bending)]
     pub bending: f64,
+    /// Mass μ/Δt² relative to the data weight: 0 integrates the first-order
+    /// (massless) dynamics, above 0 the paper's second-order dynamics.
+    #[arg(long, value_name = "μ", default_value_t = FitParams::default().mass)]
+    pub mass: f64,
     /// Also write a dense limit-surface tessellation (K×K per quad, see --tess).
     #[arg(long, value_name = "SURF")]
     pub limit_out: Option<PathBuf>,
@@ -108,6 +112,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         max_level: args.max_level,
         tension: args.tension,
         bending: args.bending,
+        mass: args.mass,
         ..Default::default()
     };
     params.check()?;

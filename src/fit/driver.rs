@@ -13,6 +13,16 @@
 //! weights). When it settles (relative change below the tolerance) the error
 //! is measured; above the tolerance the control mesh is subdivided — the
 //! new control points `S p` describe the same surface — and the fit goes on.
+//!
+//! With a mass (`FitParams::mass` > 0) the steps integrate the paper's
+//! second-order dynamics `M p̈ + D ṗ + K p = f_p` (eq. 16) by backward
+//! differences, `p̈ ≈ (p⁺ − 2p + p⁻)/Δt²`, `ṗ ≈ (p⁺ − p)/Δt`:
+//!
+//! `(μ/Δt² · M + γ/Δt · D + K + Σ k JᵀJ) p⁺ = μ/Δt² · M (2p − p⁻) + γ/Δt · D p + Σ k Jᵀ d`,
+//!
+//! unconditionally stable like the first-order step. The model then carries
+//! momentum, so the potential energy may rise for a step while it
+//! overshoots; the stop rules are the same.
 
 use std::time::Instant;
 
@@ -105,7 +115,14 @@ pub fn fit_point_cloud(
         let material = MaterialParams::thin_plate(params.tension, params.bending, area);
         let k = patch_stiffness_matrix(qtable, params.quadrature_order, &material)?;
         let d = patch_damping_matrix(qtable, params.quadrature_order, params.damping / area)?;
-        let kd = k.linear_combination(1.0, &d, 1.0)?;
+        let mut kd = k.linear_combination(1.0, &d, 1.0)?;
+        let m = if params.mass > 0.0 {
+            let m = patch_damping_matrix(qtable, params.quadrature_order, params.mass / area)?;
+            kd = kd.linear_combination(1.0, &m, 1.0)?;
+            Some(m)
+        } else {
+            None
+        };
         // Surface samples (cell centres of every patch) for the
         // surface-to-data springs.
         let per_side = params.surface_samples;
@@ -123,6 +140,8 @@ pub fn fit_point_cloud(
         }
         let centres = centres.compose(s)?;
         let mut p = mesh.positions.clone();
+        // The previous step's positions (at rest when a level starts).
+        let mut p_before = p.clone();
         let mut energy: Vec<Real> = Vec::new();
         let (mut step_elapsed, mut step_rms_pct, mut step_p95_pct) =
             (Vec::new(), Vec::new(), Vec::new());
@@ -197,12 +216,23 @@ pub fn fit_point_cloud(
             }
             let a = kd.linear_combination(1.0, &springs.matrix, 1.0)?;
             let dp = d.apply(&p)?;
-            let rhs: Vec<Point3> = springs
+            let mut rhs: Vec<Point3> = springs
                 .rhs
                 .iter()
                 .zip(&dp)
                 .map(|(a, b)| Point3::from(a.coords + b.coords))
                 .collect();
+            if let Some(m) = &m {
+                let inertia: Vec<Point3> = p
+                    .iter()
+                    .zip(&p_before)
+                    .map(|(a, b)| Point3::from(2.0 * a.coords - b.coords))
+                    .collect();
+                for (r, x) in rhs.iter_mut().zip(m.apply(&inertia)?) {
+                    r.coords += x.coords;
+                }
+            }
+            p_before.clone_from(&p);
             let report = pcg(
                 &a,
                 &rhs,

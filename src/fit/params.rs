@@ -58,6 +58,10 @@ pub struct FitParams {
     /// Damping over the time step, `γ / Δt`, relative to the total data
     /// weight (default 0.05): the proximal term of the implicit step.
     pub damping: Real,
+    /// Mass over the time step squared, `μ / Δt²`, relative to the total
+    /// data weight like `damping` (default 0: the first-order, massless
+    /// dynamics; above 0 the paper's second-order dynamics, see the driver).
+    pub mass: Real,
     /// Weight of the surface-to-data springs (each surface sample pulled to
     /// its nearest data point, Huber-weighted) relative to the data-to-surface
     /// springs (default 0.5; 0 turns them off).
@@ -98,6 +102,7 @@ impl Default for FitParams {
             tension: 1e-5,
             bending: 1e-4,
             damping: 0.05,
+            mass: 0.0,
             surface_weight: 0.5,
             cg_tolerance: 1e-5,
             points_per_control_point: 20,
@@ -143,6 +148,7 @@ impl FitParams {
             ("tension", self.tension),
             ("bending", self.bending),
             ("damping", self.damping),
+            ("mass", self.mass),
             ("surface_weight", self.surface_weight),
         ] {
             if !(v.is_finite() && v >= 0.0) {
