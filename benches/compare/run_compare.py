@@ -466,7 +466,7 @@ def scaling_lines(rows: list[dict]) -> list[str]:
             L.append(f"| {fmt(r.get('points'))} | {r['resolution']} | — | — | — | — | — | — | {r['error'][:60]} |")
             continue
         L.append(f"| {r['points']:,} | {r['resolution']} | {r['seconds']:.2f} | {1e6 * r['seconds'] / r['points']:.0f} | "
-                 f"{fmt(r.get('control_points'))} | {fmt(r.get('levels'))} | {fmt(r['chamfer_pct'], 4)} | "
+                 f"{r['control_points']:,} | {fmt(r.get('levels'))} | {fmt(r['chamfer_pct'], 4)} | "
                  f"{fmt(r['hausdorff_pct'], 3)} | {', '.join(str(x) for x in r['loadavg'])} |")
     L.append("")
     return L
