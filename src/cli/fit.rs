@@ -7,6 +7,7 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use serde_json::json;
 
+use subdyn::fit::init::InitParams;
 use subdyn::fit::{FitParams, FitReport, ToleranceStat, fit_point_cloud};
 use subdyn::io::{read_points, write_mesh};
 use subdyn::limit::tessellate;
@@ -63,6 +64,11 @@ pub struct FitArgs {
     /// Bending weight λ_b of the thin plate (β = λ_b / area).
     #[arg(long, value_name = "λ", default_value_t = FitParams::default().bending)]
     pub bending: f64,
+    /// Resolution of the automatic initial model: voxels along the longest
+    /// axis of the occupancy cage, grid cells of the open grid. Holes and gaps
+    /// narrower than about 4 voxels close up; raise it for thin gaps.
+    #[arg(long, value_name = "N", default_value_t = InitParams::default().resolution)]
+    pub init_resolution: usize,
     /// Mass μ/Δt² relative to the data weight: 0 integrates the first-order
     /// (massless) dynamics, above 0 the paper's second-order dynamics.
     #[arg(long, value_name = "μ", default_value_t = FitParams::default().mass)]
@@ -130,7 +136,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     };
     check_cloud(&cloud, &name)?;
     progress.stage("building the initial model");
-    let (init, init_report) = initial_model(&args.init, &cloud, args.quiet)?;
+    let (init, init_report) = initial_model(&args.init, args.init_resolution, &cloud, args.quiet)?;
     let mut fit_progress = |level: usize, step: usize, energy: f64| {
         progress.stage(format!("level {level}, step {step}: energy {energy:.4e}"));
     };
@@ -220,12 +226,14 @@ fn check_cloud(cloud: &PointCloud, name: &str) -> anyhow::Result<()> {
 /// The initial control mesh: a file, or `auto`.
 fn initial_model(
     init: &str,
+    resolution: usize,
     cloud: &PointCloud,
     quiet: bool,
 ) -> anyhow::Result<(PolyMesh, serde_json::Value)> {
     if let Ok(kind) = init.parse::<subdyn::fit::init::InitKind>() {
-        let params = subdyn::fit::init::InitParams {
+        let params = InitParams {
             kind,
+            resolution,
             ..Default::default()
         };
         let (mesh, report) = subdyn::fit::init::initial_mesh(cloud, &params)?;

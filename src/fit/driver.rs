@@ -148,6 +148,7 @@ pub fn fit_point_cloud(
         let mut cg_iterations = 0;
         let mut steps = 0;
         let mut hints: Option<Vec<(u32, [Real; 2])>> = None;
+        let mut trimmed_before: Option<Real> = None;
         let used = &shuffled[..shuffled
             .len()
             .min(
@@ -172,6 +173,10 @@ pub fn fit_point_cloud(
             let dist: Vec<Real> = closest.iter().map(|c| c.distance).collect();
             let w = robust_weights(&dist, params.robust, 1e-6 * diameter);
             let kw: Vec<Real> = w.iter().map(|w| w / n).collect();
+            // RMS of the nearest 95 % of the distances: the stall test below
+            // must not be dominated by outliers (the full RMS is) nor jump as
+            // the robust weights admit or drop points (the inliers' RMS does).
+            let trimmed = trimmed_rms(&dist, 0.95);
             let mut springs = spring_system(&engine, used, &closest, &kw)?;
             if params.surface_weight > 0.0 {
                 // Surface-to-data springs: every surface sample to its
@@ -204,9 +209,9 @@ pub fn fit_point_cloud(
             let stats = ErrorStats::new(&dist, diameter);
             let settled = energy.last().is_some_and(|&prev: &Real| {
                 (prev - e).abs() <= params.energy_tolerance * prev.abs()
-            }) || step_rms_pct
-                .last()
-                .is_some_and(|&prev: &Real| prev - stats.rms_pct <= params.error_tolerance * prev);
+            }) || trimmed_before
+                .is_some_and(|prev: Real| prev - trimmed <= params.error_tolerance * prev);
+            trimmed_before = Some(trimmed);
             energy.push(e);
             step_elapsed.push(start.elapsed().as_secs_f64());
             step_rms_pct.push(stats.rms_pct);
@@ -267,13 +272,13 @@ pub fn fit_point_cloud(
             points_used: used.len(),
             rejected: w.iter().filter(|&&w| w == 0.0).count() as Real / n_all,
         });
-        let stat = match params.tolerance_stat {
-            ToleranceStat::Max => error.max_pct,
-            ToleranceStat::P95 => error.p95_pct,
-            ToleranceStat::Rms => error.rms_pct,
-            ToleranceStat::Mean => error.mean_pct,
+        let stat_of = |e: &ErrorStats| match params.tolerance_stat {
+            ToleranceStat::Max => e.max_pct,
+            ToleranceStat::P95 => e.p95_pct,
+            ToleranceStat::Rms => e.rms_pct,
+            ToleranceStat::Mean => e.mean_pct,
         };
-        if stat <= params.tolerance_pct {
+        if stat_of(&error) <= params.tolerance_pct {
             break (true, format!("tolerance met at level {level}"));
         }
         if level >= params.max_level {
@@ -282,13 +287,17 @@ pub fn fit_point_cloud(
                 format!("maximum level {level} reached above the tolerance"),
             );
         }
+        // The gain is judged on the tolerance's statistic (the 95th
+        // percentile by default), which outliers do not dominate as they do
+        // the RMS.
         if let [.., before, last] = levels.as_slice()
-            && last.error.rms > (1.0 - params.min_level_gain) * before.error.rms
+            && stat_of(&last.error) > (1.0 - params.min_level_gain) * stat_of(&before.error)
         {
             break (
                 false,
                 format!(
-                    "level {level} lowered the RMS error by less than {:.0} %: finer levels would fit the noise",
+                    "level {level} lowered the {:?} error by less than {:.0} %: finer levels would fit the noise",
+                    params.tolerance_stat,
                     100.0 * params.min_level_gain
                 ),
             );
@@ -320,4 +329,15 @@ pub fn fit_point_cloud(
             seconds: start.elapsed().as_secs_f64(),
         },
     })
+}
+
+/// Root mean square of the smallest `fraction` of `d`.
+fn trimmed_rms(d: &[Real], fraction: Real) -> Real {
+    let mut sorted = d.to_vec();
+    let keep = ((fraction * d.len() as Real).ceil() as usize).clamp(1, d.len().max(1));
+    if sorted.is_empty() {
+        return 0.0;
+    }
+    sorted.select_nth_unstable_by(keep - 1, |a, b| a.total_cmp(b));
+    (sorted[..keep].iter().map(|x| x * x).sum::<Real>() / keep as Real).sqrt()
 }

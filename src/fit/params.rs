@@ -34,7 +34,8 @@ pub struct FitParams {
     /// A level has settled when the energy changes by less than this fraction
     /// between steps (default 1e-3) …
     pub energy_tolerance: Real,
-    /// … or when a step lowers the RMS data-to-surface distance by less than
+    /// … or when a step lowers the RMS of the nearest 95 % of the
+    /// data-to-surface distances (robust to up to 5 % outliers) by less than
     /// this fraction (default 0.01; 0 turns this test off).
     pub error_tolerance: Real,
     /// Closest points are found by Newton descent from the previous step's
@@ -42,8 +43,8 @@ pub struct FitParams {
     /// seed sample, which catches a point whose closest surface part has
     /// changed but needs the seeds' k-d tree rebuilt.
     pub reseed_every: usize,
-    /// Stop subdividing when a level lowers the RMS error by less than this
-    /// fraction (default 0.1): finer levels would fit the noise.
+    /// Stop subdividing when a level lowers the `tolerance_stat` error by
+    /// less than this fraction (default 0.1): finer levels would fit the noise.
     pub min_level_gain: Real,
     /// Do not subdivide when the next level would have more control points
     /// than this fraction of the data points (default 0.5).
