@@ -997,3 +997,54 @@ fn closest_point_engine_set_positions_equals_a_fresh_engine() {
         "wrong count must be rejected"
     );
 }
+
+/// After a small move of the control points, descending from the previous
+/// answers alone (`closest_points_local`) finds the same closest points as a
+/// full seeded search, and an engine moved by `set_positions` (whose seed
+/// tree is rebuilt lazily) answers as a freshly built one.
+#[test]
+fn local_descents_after_a_small_move_match_full_searches() {
+    let mesh = subdyn::examples::cube();
+    let r = default_refiner(&mesh);
+    let mut engine =
+        ClosestPointEngine::new(&r, &mesh.positions, &ClosestPointParams::default()).unwrap();
+    let mut rng = Rng::new(5);
+    let queries: Vec<Point3> = (0..400)
+        .map(|_| {
+            Point3::new(
+                rng.uniform(-0.3, 1.3),
+                rng.uniform(-0.3, 1.3),
+                rng.uniform(-0.3, 1.3),
+            )
+        })
+        .collect();
+    let before = engine.closest_points(&queries).unwrap();
+    let moved: Vec<Point3> = mesh
+        .positions
+        .iter()
+        .map(|p| Point3::new(1.01 * p.x + 0.002, p.y - 0.003 * p.z, 0.99 * p.z))
+        .collect();
+    engine.set_positions(&moved).unwrap();
+    let starts: Vec<_> = before.iter().map(|c| c.patch).collect();
+    let local = engine.closest_points_local(&queries, &starts).unwrap();
+    let full = engine.closest_points(&queries).unwrap();
+    let fresh = ClosestPointEngine::new(&r, &moved, &ClosestPointParams::default())
+        .unwrap()
+        .closest_points(&queries)
+        .unwrap();
+    let d = diag(&moved);
+    for ((l, f), g) in local.iter().zip(&full).zip(&fresh) {
+        assert!(
+            (l.distance - f.distance).abs() <= 1e-12 * d,
+            "local {} vs full {}",
+            l.distance,
+            f.distance
+        );
+        assert!(
+            (f.distance - g.distance).abs() <= 1e-14 * d,
+            "moved {} vs fresh {}",
+            f.distance,
+            g.distance
+        );
+    }
+}
