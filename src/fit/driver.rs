@@ -38,6 +38,7 @@ use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
 use crate::subdivision::{RefineOptions, Refiner};
 
+use super::sampling::{shuffled, surface_samples, trimmed_rms};
 use super::{ErrorStats, FitParams, FitReport, LevelReport, ToleranceStat};
 
 /// A fitted model and what it took.
@@ -78,22 +79,8 @@ pub fn fit_point_cloud(
     );
     let mut mesh = init.clone();
     let mut levels = Vec::new();
-    // A fixed pseudo-random order of the points: each level uses a prefix
-    // of it, so coarse levels see an even subsample.
-    let shuffled: Vec<Point3> = {
-        let mut order: Vec<(u64, usize)> = (0..points.len())
-            .map(|i| {
-                (
-                    (i as u64 + 1)
-                        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-                        .rotate_left(29),
-                    i,
-                )
-            })
-            .collect();
-        order.sort_unstable();
-        order.into_iter().map(|(_, i)| points[i]).collect()
-    };
+    // Each level uses a prefix of a fixed even shuffle of the points.
+    let shuffled = shuffled(points);
     let n_all = points.len() as Real;
     let (converged, stop_reason) = loop {
         let level = levels.len();
@@ -109,36 +96,21 @@ pub fn fit_point_cloud(
         )?;
         // The thin plate and the damping, patch by patch on the engine's
         // pieces: exact on regular faces (one bicubic each).
-        let qtable = engine.table();
-        let s = qtable.to_level();
-        let area = parameter_area(qtable);
+        let table = engine.table();
+        let s = table.to_level();
+        let area = parameter_area(table);
         let material = MaterialParams::thin_plate(params.tension, params.bending, area);
-        let k = patch_stiffness_matrix(qtable, params.quadrature_order, &material)?;
-        let d = patch_damping_matrix(qtable, params.quadrature_order, params.damping / area)?;
+        let k = patch_stiffness_matrix(table, params.quadrature_order, &material)?;
+        let d = patch_damping_matrix(table, params.quadrature_order, params.damping / area)?;
         let mut kd = k.linear_combination(1.0, &d, 1.0)?;
         let m = if params.mass > 0.0 {
-            let m = patch_damping_matrix(qtable, params.quadrature_order, params.mass / area)?;
+            let m = patch_damping_matrix(table, params.quadrature_order, params.mass / area)?;
             kd = kd.linear_combination(1.0, &m, 1.0)?;
             Some(m)
         } else {
             None
         };
-        // Surface samples (cell centres of every patch) for the
-        // surface-to-data springs.
-        let per_side = params.surface_samples;
-        let mut centres = crate::stencil::StencilTable::with_capacity(
-            qtable.to_level().num_rows(),
-            per_side * per_side * qtable.num_patches(),
-            0,
-        );
-        for f in 0..qtable.num_patches() {
-            for i in 0..per_side * per_side {
-                let st = [i % per_side, i / per_side].map(|k| (k as Real + 0.5) / per_side as Real);
-                let (cols, w) = qtable.position_stencil(f, st);
-                centres.push_row(cols.into_iter().zip(w));
-            }
-        }
-        let centres = centres.compose(s)?;
+        let centres = surface_samples(table, params.surface_samples).compose(s)?;
         let mut p = mesh.positions.clone();
         // The previous step's positions (at rest when a level starts).
         let mut p_before = p.clone();
@@ -329,15 +301,4 @@ pub fn fit_point_cloud(
             seconds: start.elapsed().as_secs_f64(),
         },
     })
-}
-
-/// Root mean square of the smallest `fraction` of `d`.
-fn trimmed_rms(d: &[Real], fraction: Real) -> Real {
-    let mut sorted = d.to_vec();
-    let keep = ((fraction * d.len() as Real).ceil() as usize).clamp(1, d.len().max(1));
-    if sorted.is_empty() {
-        return 0.0;
-    }
-    sorted.select_nth_unstable_by(keep - 1, |a, b| a.total_cmp(b));
-    (sorted[..keep].iter().map(|x| x * x).sum::<Real>() / keep as Real).sqrt()
 }

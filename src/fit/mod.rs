@@ -8,6 +8,7 @@ pub mod init;
 mod params;
 pub mod recover;
 mod report;
+mod sampling;
 
 pub use driver::{FitResult, fit_point_cloud};
 pub use params::{FitParams, ToleranceStat};
