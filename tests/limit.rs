@@ -1032,7 +1032,32 @@ fn local_descents_after_a_small_move_match_full_searches() {
         .unwrap()
         .closest_points(&queries)
         .unwrap();
+    // A looser Newton tolerance (what fitting uses) gives the same distances.
+    let loose = ClosestPointEngine::new(
+        &r,
+        &moved,
+        &ClosestPointParams {
+            tolerance: 1e-7,
+            ..Default::default()
+        },
+    )
+    .unwrap()
+    .closest_points(&queries)
+    .unwrap();
+    let zero = ClosestPointParams {
+        tolerance: 0.0,
+        ..Default::default()
+    };
+    assert!(ClosestPointEngine::new(&r, &moved, &zero).is_err());
     let d = diag(&moved);
+    for (l, g) in loose.iter().zip(&fresh) {
+        assert!(
+            (l.distance - g.distance).abs() <= 1e-13 * d,
+            "tolerance 1e-7: {} vs {}",
+            l.distance,
+            g.distance
+        );
+    }
     for ((l, f), g) in local.iter().zip(&full).zip(&fresh) {
         assert!(
             (l.distance - f.distance).abs() <= 1e-12 * d,

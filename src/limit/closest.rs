@@ -40,6 +40,11 @@ pub struct ClosestPointParams {
     pub candidates: usize,
     /// Newton iterations per seed (default 30).
     pub max_iterations: usize,
+    /// A descent stops when a step moves less than this in the patch's
+    /// `(s, t)` (default 1e-13). The distance is stationary at the answer, so
+    /// its error is of the order of the square of this times the patch size:
+    /// fitting can use 1e-7 and still get distances to round-off.
+    pub tolerance: Real,
 }
 
 impl Default for ClosestPointParams {
@@ -49,6 +54,7 @@ impl Default for ClosestPointParams {
             seeds_per_side: 3,
             candidates: 3,
             max_iterations: 30,
+            tolerance: 1e-13,
         }
     }
 }
@@ -90,6 +96,12 @@ impl ClosestPointEngine {
             return Err(Error::Input(format!(
                 "closest-point level {} must be between 1 and 6",
                 params.level
+            )));
+        }
+        if !(params.tolerance > 0.0 && params.tolerance < 1.0) {
+            return Err(Error::Input(format!(
+                "closest-point tolerance {} must be in (0, 1)",
+                params.tolerance
             )));
         }
         if params.seeds_per_side == 0 || params.candidates == 0 || params.max_iterations == 0 {
@@ -287,7 +299,7 @@ impl ClosestPointEngine {
     ) -> Result<(usize, [Real; 2], PatchPoint)> {
         let mut e = self.table.eval(f, st)?;
         let mut crossings = 0;
-        let tol = 1e-13;
+        let tol = self.params.tolerance;
         for _ in 0..self.params.max_iterations {
             let r = e.p - q;
             let (ps, pt) = (e.d[0], e.d[1]);
