@@ -39,7 +39,7 @@ use crate::mesh::{PointCloud, PolyMesh};
 use crate::subdivision::{RefineOptions, Refiner};
 
 use super::sampling::{shuffled, surface_samples, trimmed_rms};
-use super::{ErrorStats, FitParams, FitReport, LevelReport, ToleranceStat};
+use super::{ErrorStats, FitParams, FitReport, LevelReport};
 
 /// A fitted model and what it took.
 #[derive(Clone, Debug)]
@@ -247,13 +247,8 @@ pub fn fit_point_cloud(
             points_used: used.len(),
             rejected: w.iter().filter(|&&w| w == 0.0).count() as Real / n_all,
         });
-        let stat_of = |e: &ErrorStats| match params.tolerance_stat {
-            ToleranceStat::Max => e.max_pct,
-            ToleranceStat::P95 => e.p95_pct,
-            ToleranceStat::Rms => e.rms_pct,
-            ToleranceStat::Mean => e.mean_pct,
-        };
-        if stat_of(&error) <= params.tolerance_pct {
+        let stat = params.tolerance_stat;
+        if error.pct(stat) <= params.tolerance_pct {
             break (true, format!("tolerance met at level {level}"));
         }
         if level >= params.max_level {
@@ -266,7 +261,7 @@ pub fn fit_point_cloud(
         // percentile by default), which outliers do not dominate as they do
         // the RMS.
         if let [.., before, last] = levels.as_slice()
-            && stat_of(&last.error) > (1.0 - params.min_level_gain) * stat_of(&before.error)
+            && last.error.pct(stat) > (1.0 - params.min_level_gain) * before.error.pct(stat)
         {
             break (
                 false,

@@ -2,6 +2,7 @@
 
 use serde::Serialize;
 
+use super::ToleranceStat;
 use crate::math::Real;
 
 /// Statistics of data-to-surface distances, in absolute units and in % of the
@@ -50,6 +51,16 @@ impl ErrorStats {
             mean_pct: pct(mean),
             rms_pct: pct(rms),
             p95_pct: pct(p95),
+        }
+    }
+
+    /// The statistic `stat`, in % of the diameter.
+    pub fn pct(&self, stat: ToleranceStat) -> Real {
+        match stat {
+            ToleranceStat::Max => self.max_pct,
+            ToleranceStat::P95 => self.p95_pct,
+            ToleranceStat::Rms => self.rms_pct,
+            ToleranceStat::Mean => self.mean_pct,
         }
     }
 }

@@ -248,19 +248,8 @@ impl ClosestPointEngine {
         queries: &[Point3],
         hints: &[(u32, [Real; 2])],
     ) -> Result<Vec<ClosestPoint>> {
-        if hints.len() != queries.len() {
-            return Err(Error::Input(format!(
-                "{} hints for {} queries",
-                hints.len(),
-                queries.len()
-            )));
-        }
         self.seed_tree()?;
-        queries
-            .par_iter()
-            .zip(hints)
-            .map(|(&q, &h)| self.closest_point_near(q, Some(h)))
-            .collect()
+        self.each_with_start(queries, hints, |q, h| self.closest_point_near(q, Some(h)))
     }
 
     /// [`closest_point_local`](Self::closest_point_local) for many queries,
@@ -270,9 +259,19 @@ impl ClosestPointEngine {
         queries: &[Point3],
         starts: &[(u32, [Real; 2])],
     ) -> Result<Vec<ClosestPoint>> {
+        self.each_with_start(queries, starts, |q, s| self.closest_point_local(q, s))
+    }
+
+    /// `query(q, start)` for every query and its start, in parallel.
+    fn each_with_start(
+        &self,
+        queries: &[Point3],
+        starts: &[(u32, [Real; 2])],
+        query: impl Fn(Point3, (u32, [Real; 2])) -> Result<ClosestPoint> + Sync,
+    ) -> Result<Vec<ClosestPoint>> {
         if starts.len() != queries.len() {
             return Err(Error::Input(format!(
-                "{} starts for {} queries",
+                "{} starting points for {} queries",
                 starts.len(),
                 queries.len()
             )));
@@ -280,7 +279,7 @@ impl ClosestPointEngine {
         queries
             .par_iter()
             .zip(starts)
-            .map(|(&q, &s)| self.closest_point_local(q, s))
+            .map(|(&q, &s)| query(q, s))
             .collect()
     }
 
