@@ -62,7 +62,13 @@ pub fn initial_mesh(points: &PointCloud, params: &InitParams) -> Result<(PolyMes
         InitKind::Closed => closed(&frame, "requested".into()),
         InitKind::Open => open(points, &frame, params, "requested".into()),
         InitKind::Occupancy => {
-            let occ = occupancy_cage(&points.positions, &frame, res, params.smoothing_steps)?;
+            let occ = occupancy_cage(
+                &points.positions,
+                &frame,
+                res,
+                params.max_refinement,
+                params.smoothing_steps,
+            )?;
             occupancy(occ, "requested".into())
         }
         InitKind::Auto => {
@@ -79,7 +85,13 @@ pub fn initial_mesh(points: &PointCloud, params: &InitParams) -> Result<(PolyMes
                     format!("{measured}: one range view"),
                 )
             } else {
-                let occ = occupancy_cage(&points.positions, &frame, res, params.smoothing_steps)?;
+                let occ = occupancy_cage(
+                    &points.positions,
+                    &frame,
+                    res,
+                    params.max_refinement,
+                    params.smoothing_steps,
+                )?;
                 occupancy(occ, format!("{measured}: closed"))
             }
         }
@@ -177,18 +189,22 @@ fn open(
 fn occupancy(occ: OccupancyCage, why: String) -> Result<(PolyMesh, InitReport)> {
     let topo = checked(&occ.mesh, true)?;
     let reason = format!(
-        "{why}; occupancy cage of genus {} from a {}×{}×{} grid (voxel {:.4}): {} shell, \
-         {} solid voxels, closing {} ({:.0} % of interior probes outside), {} stray components \
-         dropped, {} voxels filled for manifoldness",
+        "{why}; occupancy cage of genus {} from a {}×{}×{} grid (voxel {:.4}{}): {} shell, \
+         {} solid voxels, closing {} ({:.0} % of interior probes outside), {} voxels carved (normals {:.0} % \
+         consistent), {} stray components dropped, {} voxels filled for manifoldness",
         topo,
         occ.dims[0],
         occ.dims[1],
         occ.dims[2],
         occ.voxel,
+        occ.gap
+            .map_or(String::new(), |g| format!(", narrowest gaps {g:.4}")),
         occ.occupied,
         occ.solid,
         occ.closing,
         100.0 * occ.leak,
+        occ.carved.removed,
+        100.0 * occ.carved.agreement,
         occ.dropped_components,
         occ.repair.repairs + occ.repair.cavities
     );

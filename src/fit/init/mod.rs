@@ -21,12 +21,15 @@
 //! # Ok::<(), subdyn::Error>(())
 //! ```
 
+pub mod carve;
 pub mod detect;
 pub mod ellipsoid;
 pub mod footprint;
 pub mod frame;
+pub mod gaps;
 pub mod height_grid;
 mod initial;
+pub mod normals;
 pub mod occupancy;
 pub mod outliers;
 mod params;

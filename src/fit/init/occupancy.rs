@@ -37,8 +37,11 @@
 //!
 //! The genus comes from `χ = V − E + F = 2c − 2g` of the closed result.
 
+use super::carve::{CarveStats, carve};
 use super::detect::interior_probes;
 use super::frame::PrincipalFrame;
+use super::gaps::narrow_gap;
+use super::normals::{SignedDistance, oriented_normals};
 use super::sampling::{point_tree, sampling_radius, snapped_to_points};
 use super::surface::{SurfaceTopology, reversed, signed_volume, surface_topology};
 use super::voxel_repair::{RepairStats, make_manifold};
@@ -52,6 +55,9 @@ use crate::mesh::PolyMesh;
 /// balls (at most `2h`), the closing's dilations and one free layer for the
 /// flood fill to pass around the object.
 const MARGIN: usize = 3 + MAX_CLOSING;
+
+/// Voxels a narrow gap must span to stay open ([`super::carve`]).
+const GAP_VOXELS: Real = 1.5;
 
 /// Largest closing tried when the plain fill leaks.
 const MAX_CLOSING: usize = 3;
@@ -70,6 +76,8 @@ pub struct OccupancyCage {
     pub dims: [usize; 3],
     /// Voxel side `h`.
     pub voxel: Real,
+    /// Narrow-gap width that set `h` ([`narrow_gap`]), if any was found.
+    pub gap: Option<Real>,
     /// Sampling radius `r` used for the shell.
     pub radius: Real,
     /// Voxels of the shell.
@@ -80,6 +88,8 @@ pub struct OccupancyCage {
     pub closing: usize,
     /// Fraction of interior probes outside the chosen solid.
     pub leak: Real,
+    /// What the signed-distance carving did.
+    pub carved: CarveStats,
     /// Solid components dropped (outliers, clutter).
     pub dropped_components: usize,
     /// What the manifold repair filled.
@@ -91,16 +101,30 @@ pub fn occupancy_cage(
     points: &[Point3],
     frame: &PrincipalFrame,
     resolution: usize,
+    max_refinement: Real,
     smoothing_steps: usize,
 ) -> Result<OccupancyCage> {
     let ext = frame.extents();
-    let h = ext[0].max(ext[1]).max(ext[2]) / resolution as Real;
+    let coarse = ext[0].max(ext[1]).max(ext[2]) / resolution as Real;
+    let tree = point_tree(points);
+    let normals = oriented_normals(points, &tree);
+    let spacing = sampling_radius(points, &tree);
+    let gap = narrow_gap(
+        points,
+        &normals,
+        &tree,
+        coarse / 16.0,
+        spacing,
+        1.5 * coarse,
+    );
+    let h = gap.map_or(coarse, |g| {
+        (g / GAP_VOXELS).clamp(coarse / max_refinement.max(1.0), coarse)
+    });
     let cells = ext.map(|e| (e / h).floor() as usize + 1);
     // Centre the occupied box in its cells.
     let lo: [Real; 3] = [0, 1, 2].map(|k| frame.lo[k] - 0.5 * (cells[k] as Real * h - ext[k]));
     let dims = cells.map(|c| c + 2 * MARGIN);
-    let tree = point_tree(points);
-    let r = sampling_radius(points, &tree).clamp(0.01 * h, 2.0 * h);
+    let r = spacing.clamp(0.01 * h, 2.0 * h);
     let mut grid = VoxelGrid::new(dims);
     let voxel_of = |x: Real, k: usize| ((x - lo[k]) / h).floor() as isize + MARGIN as isize;
     for p in points {
@@ -150,6 +174,17 @@ pub fn occupancy_cage(
         solid = grid.closed_solid(closing);
         leak = leak_of(&solid);
     }
+    let sd = SignedDistance::new(points, &normals, &tree);
+    let local = |x: [Real; 3]| {
+        let l = Vector3::from_fn(|k, _| lo[k] + (x[k] - MARGIN as Real) * h);
+        frame.world(&l)
+    };
+    let lookup = VoxelGrid::new(dims);
+    let voxel_index = |p: &Point3| {
+        let l = frame.local(p);
+        lookup.index([0, 1, 2].map(|k| voxel_of(l[k], k)))
+    };
+    let carved = carve(&mut solid, points, &normals, &sd, h, local, voxel_index);
     let mut dropped_components = solid.keep_largest_component();
     let repair = make_manifold(&mut solid);
     dropped_components += solid.keep_largest_component();
@@ -158,15 +193,7 @@ pub fn occupancy_cage(
             "the points' occupancy is empty; cannot build an occupancy cage".into(),
         ));
     }
-    let corner = |c: [usize; 3]| {
-        let l = Vector3::new(
-            lo[0] + (c[0] as Real - MARGIN as Real) * h,
-            lo[1] + (c[1] as Real - MARGIN as Real) * h,
-            lo[2] + (c[2] as Real - MARGIN as Real) * h,
-        );
-        frame.world(&l)
-    };
-    let blocky = boundary_quads(&solid, corner)?;
+    let blocky = boundary_quads(&solid, |c| local(c.map(|x| x as Real)))?;
     let smooth = taubin_smoothed(&blocky, smoothing_steps);
     let mut mesh = snapped_to_points(&smooth, points, &tree, 2.0 * h)?;
     if signed_volume(&mesh) < 0.0 {
@@ -184,11 +211,13 @@ pub fn occupancy_cage(
         topology,
         dims,
         voxel: h,
+        gap,
         radius: r,
         occupied,
         solid: solid.count(),
         closing,
         leak,
+        carved,
         dropped_components,
         repair,
     })

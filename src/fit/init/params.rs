@@ -72,6 +72,12 @@ pub struct InitParams {
     /// `Auto` to call a cloud closed. Default 0.3: single range views measure
     /// below 0.02, scans from three or more views above 0.6, from two 0.36.
     pub closed_threshold: Real,
+    /// How much finer than `resolution` the occupancy voxel may become to
+    /// keep a narrow gap between facing sheets open (legs, fingers; see
+    /// [`super::gaps`]): the voxel is `gap / 1.5`, but at least `1 /
+    /// max_refinement` of the resolution's voxel. Default 2; 1 disables;
+    /// 1 ..= 8.
+    pub max_refinement: Real,
     /// Taubin λ|μ smoothing steps applied to the occupancy cage. Default 10.
     pub smoothing_steps: usize,
     /// Minimum number of points for a grid cell to belong to the open
@@ -85,6 +91,7 @@ impl Default for InitParams {
             kind: InitKind::Auto,
             resolution: 12,
             closed_threshold: 0.3,
+            max_refinement: 2.0,
             smoothing_steps: 10,
             min_cell_points: 1,
         }
@@ -104,6 +111,12 @@ impl InitParams {
             return Err(Error::Input(format!(
                 "closed threshold {} is out of range: expected a fraction in [0, 1]",
                 self.closed_threshold
+            )));
+        }
+        if !(1.0..=8.0).contains(&self.max_refinement) {
+            return Err(Error::Input(format!(
+                "occupancy refinement {} is out of range: expected 1 to 8",
+                self.max_refinement
             )));
         }
         if self.smoothing_steps > 1000 {
