@@ -6,14 +6,20 @@
 //! up in one solid and the cage joins them with a web no fit can remove:
 //! the genus and the sheet structure of a cage are fixed. The oriented
 //! tangent planes of the points ([`super::normals`], Hoppe et al. 1992)
-//! tell inside from outside at sub-voxel scale, so each solid voxel is
-//! sampled at its 3 × 3 × 3 sub-cell centres and removed when fewer than a
-//! quarter of them are inside (signed distance ≤ 0) and a point lies within
-//! two voxels of its centre (far from the points the planes are
-//! extrapolations and decide nothing). A gap at least 1.5 voxels wide
-//! always contains a voxel that is three-quarters outside, so it opens; a
-//! part thinner than a voxel keeps its voxels as long as a quarter of their
-//! samples are inside.
+//! tell inside from outside at sub-voxel scale. A solid voxel is removed
+//! when
+//!
+//! - its centre lies between two sheets of surface facing each other within
+//!   two voxels ([`SignedDistance::between_sheets`]): a web spans free
+//!   space there, whereas the outside of a lone thin part (a horn) faces
+//!   one sheet only, and far from the points the planes are extrapolations
+//!   that decide nothing; and
+//! - of its 3 × 3 × 3 sub-cell centres, fewer than a quarter are inside
+//!   (signed distance ≤ 0), or none at all when the voxel holds points. A
+//!   gap at least 1.5 voxels wide always contains a voxel three-quarters
+//!   outside. The stricter rule for voxels holding points keeps a part
+//!   thinner than a voxel that runs through them; a voxel at the side of a
+//!   gap that catches a few noisy points of the wall is still all outside.
 //!
 //! Carving trusts the normals' orientation, so it first checks them
 //! against the flood fill: a point's normal should lead to an outside
@@ -79,7 +85,7 @@ pub fn carve(
         };
     }
     let remove: Vec<usize> = (0..solid.solid.len())
-        .filter(|&n| solid.solid[n] && !holds_points[n])
+        .filter(|&n| solid.solid[n])
         .filter(|&n| {
             let c = solid.coords(n).map(|x| x as Real);
             if !sd.between_sheets(&world([c[0] + 0.5, c[1] + 0.5, c[2] + 0.5]), 2.0 * h) {
@@ -92,7 +98,11 @@ pub fn carve(
                 let (d, _) = sd.at(&world([c[0] + s[0], c[1] + s[1], c[2] + s[2]]));
                 inside += usize::from(d <= 0.0);
             }
-            (inside as Real) < INSIDE_FRACTION * (SUB * SUB * SUB) as Real
+            if holds_points[n] {
+                inside == 0
+            } else {
+                (inside as Real) < INSIDE_FRACTION * (SUB * SUB * SUB) as Real
+            }
         })
         .collect();
     for &n in &remove {
