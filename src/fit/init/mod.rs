@@ -9,7 +9,7 @@
 //! |---|---|---|
 //! | [`InitKind::Closed`] ([`ellipsoid`]) | closed, genus 0 | 26 vertices, 24 quads on the points' principal-axes ellipsoid |
 //! | [`InitKind::Open`] ([`height_grid`]) | one range view | open quad grid over the principal plane, trimmed to the footprint |
-//! | [`InitKind::Occupancy`] ([`occupancy`]) | closed, any genus | smoothed boundary of the points' voxel occupancy, made manifold ([`voxel_repair`]) |
+//! | [`InitKind::Occupancy`] ([`occupancy`]) | closed, any genus | smoothed boundary of the points' voxel occupancy, carved between facing sheets ([`carve`]), made manifold ([`voxel_repair`]) |
 //! | [`InitKind::Auto`] ([`detect`]) | default | open if the layered fraction is below 0.3; else occupancy, replaced by the ellipsoid when its genus is 0 |
 //!
 //! ```no_run

@@ -5,7 +5,10 @@
 //! shapes of higher genus a sphere-like start cannot change topology, so the
 //! cage must already have the right genus. Steps, all on a grid aligned with
 //! the principal axes, `resolution` voxels of side `h` along the longest
-//! extent plus a 6-voxel margin on each side:
+//! extent plus a 6-voxel margin on each side. When the points have narrow
+//! gaps between facing sheets ([`narrow_gap`]), `h` shrinks to two-thirds of
+//! the gap, down to `1 / max_refinement` of that voxel, so carving can open
+//! them:
 //!
 //! 1. *shell*: every voxel that meets a ball of radius `r` around a point,
 //!    `r` the sampling radius ([`sampling_radius`], clamped to `[h/100, 2h]`).
@@ -23,7 +26,10 @@
 //!    as a *closing* by `k = 1, 2, 3` cubes ([`VoxelGrid::closed_solid`]:
 //!    dilate `k` times, fill, erode `k` times), which closes shell gaps up to
 //!    `2k` voxels wide (and holes of the object as narrow);
-//! 3. keep the largest face-connected solid (stray outliers are dropped);
+//! 3. *carve* ([`carve`]): voxels the points' oriented tangent planes
+//!    ([`oriented_normals`]) put outside, between two facing sheets, are
+//!    removed, which opens the gaps the shell bridged (legs, fingers), then
+//!    keep the largest face-connected solid (stray outliers are dropped);
 //! 4. [`make_manifold`]: fill voxels until the boundary is a closed 2-manifold;
 //! 5. the boundary quads between solid and empty voxels, outward, with shared
 //!    lattice corners ([`boundary_quads`]);
