@@ -254,8 +254,16 @@ fn initial_model(
 }
 
 fn summary(name: &str, output: &Path, limit: Option<&Path>, r: &FitReport) -> String {
+    let left_out = if r.outliers > 0 {
+        format!(
+            ", {} outliers left out of the springs",
+            thousands(r.outliers)
+        )
+    } else {
+        String::new()
+    };
     let mut s = format!(
-        "fitted {name} ({} points) in {:.2} s: {}\n",
+        "fitted {name} ({} points{left_out}) in {:.2} s: {}\n",
         thousands(r.points),
         r.seconds,
         r.stop_reason
@@ -275,7 +283,7 @@ fn summary(name: &str, output: &Path, limit: Option<&Path>, r: &FitReport) -> St
             l.error.mean_pct
         ));
     }
-    s.push_str(&format!("errors are data-to-surface distances in % of the scan's bounding-box diagonal\ncontrol mesh written to {}\n", output.display()));
+    s.push_str(&format!("errors are data-to-surface distances from all points (outliers included) in % of the scan's bounding-box diagonal\ncontrol mesh written to {}\n", output.display()));
     if let Some(p) = limit {
         s.push_str(&format!("limit surface written to {}\n", p.display()));
     }

@@ -38,6 +38,7 @@ use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
 use crate::subdivision::{RefineOptions, Refiner};
 
+use super::init::outliers::inlier_mask;
 use super::sampling::{shuffled, surface_samples, trimmed_rms};
 use super::{ErrorStats, FitParams, FitReport, LevelReport};
 
@@ -74,13 +75,25 @@ pub fn fit_point_cloud(
         ));
     }
     let start = Instant::now();
-    let data_tree: ImmutableKdTree<Real, 3> = ImmutableKdTree::new_from_slice(
-        &points.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
-    );
+    // The springs' data: the points without the outliers.
+    let keep = if params.drop_outliers {
+        inlier_mask(points)
+    } else {
+        vec![true; points.len()]
+    };
+    let data: Vec<Point3> = points
+        .iter()
+        .zip(&keep)
+        .filter_map(|(p, &k)| k.then_some(*p))
+        .collect();
+    let data = if data.len() < 4 { points.clone() } else { data };
+    let outliers = points.len() - data.len();
+    let data_tree: ImmutableKdTree<Real, 3> =
+        ImmutableKdTree::new_from_slice(&data.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>());
     let mut mesh = init.clone();
     let mut levels = Vec::new();
     // Each level uses a prefix of a fixed even shuffle of the points.
-    let shuffled = shuffled(points);
+    let shuffled = shuffled(&data);
     let n_all = points.len() as Real;
     let (converged, stop_reason) = loop {
         let level = levels.len();
@@ -163,7 +176,7 @@ pub fn fit_point_cloud(
                     .iter()
                     .map(|x| {
                         let nn = data_tree.nearest_one::<SquaredEuclidean>(&[x.x, x.y, x.z]);
-                        (points[nn.item as usize], nn.distance.sqrt())
+                        (data[nn.item as usize], nn.distance.sqrt())
                     })
                     .collect();
                 let dd: Vec<Real> = near.iter().map(|n| n.1).collect();
@@ -292,6 +305,7 @@ pub fn fit_point_cloud(
         control: mesh,
         report: FitReport {
             points: points.len(),
+            outliers,
             diameter,
             levels,
             converged,

@@ -67,6 +67,13 @@ pub struct FitParams {
     /// its nearest data point, Huber-weighted) relative to the data-to-surface
     /// springs (default 0.5; 0 turns them off).
     pub surface_weight: Real,
+    /// Leave the points that [`crate::fit::init::outliers::inlier_mask`]
+    /// flags (far off the plane of their neighbours, or isolated) out of
+    /// both kinds of springs (default true). The robust weights alone let a
+    /// lone outlier near the surface pull a spike: it is admitted while the
+    /// coarse levels' residuals are large and stays admitted once the
+    /// surface has reached it. The error figures still cover every point.
+    pub drop_outliers: bool,
     /// A level's springs use at most this many data points per control
     /// point (default 20), an even subsample of the cloud: coarse levels
     /// cannot resolve more, and the cost of a step follows the points used.
@@ -105,6 +112,7 @@ impl Default for FitParams {
             damping: 0.05,
             mass: 0.0,
             surface_weight: 0.5,
+            drop_outliers: true,
             cg_tolerance: 1e-5,
             points_per_control_point: 20,
             surface_samples: 2,

@@ -106,6 +106,9 @@ pub struct FitReport {
     pub points: usize,
     /// The data's bounding-box diagonal (the object's diameter).
     pub diameter: Real,
+    /// Points left out of the springs as outliers
+    /// ([`FitParams::drop_outliers`](super::FitParams)).
+    pub outliers: usize,
     /// Per level, in order.
     pub levels: Vec<LevelReport>,
     /// True when the tolerance was met.
