@@ -185,10 +185,10 @@ pub fn occupancy_cage(
         let l = Vector3::from_fn(|k, _| lo[k] + (x[k] - MARGIN as Real) * h);
         frame.world(&l)
     };
-    let lookup = VoxelGrid::new(dims);
+    // The shell grid has the solid's dimensions.
     let voxel_index = |p: &Point3| {
         let l = frame.local(p);
-        lookup.index([0, 1, 2].map(|k| voxel_of(l[k], k)))
+        grid.index([0, 1, 2].map(|k| voxel_of(l[k], k)))
     };
     let carved = carve(&mut solid, points, &normals, &sd, h, local, voxel_index);
     let mut dropped_components = solid.keep_largest_component();
