@@ -179,6 +179,31 @@ impl CholeskyPattern {
         self.l_start[self.l_start.len() - 1]
     }
 
+    /// The product `A x` of the symmetric matrix whose upper triangle (in
+    /// the slots returned by [`new`](Self::new)) is `values` with `x`.
+    pub fn product(&self, values: &[Real], x: &[Real]) -> Vec<Real> {
+        let nb = self.l_start.len() - 1;
+        let mut xb = vec![Vector3::zeros(); nb];
+        for (i, &(blk, k)) in self.place.iter().enumerate() {
+            xb[blk][k] = x[i];
+        }
+        let block = |p: usize| Matrix3::from_fn(|r, c| values[9 * p + 3 * r + c]);
+        let mut y = vec![Vector3::zeros(); nb];
+        for k in 0..nb {
+            let last = self.c_start[k + 1] - 1;
+            for p in self.c_start[k]..last {
+                let (b, i) = (block(p), self.c_rows[p]);
+                y[i] += b * xb[k];
+                y[k] += b.tr_mul(&xb[i]);
+            }
+            // The diagonal block keeps its upper triangle.
+            let u = block(last);
+            let full = Matrix3::from_fn(|r, c| if r <= c { u[(r, c)] } else { u[(c, r)] });
+            y[k] += full * xb[k];
+        }
+        self.place.iter().map(|&(blk, k)| y[blk][k]).collect()
+    }
+
     /// The factor of the matrix whose upper triangle (in the slots returned by
     /// [`new`](Self::new)) is `values`; `None` if it is not positive definite.
     pub fn factor(&self, values: &[Real]) -> Option<Cholesky<'_>> {
