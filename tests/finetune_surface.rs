@@ -9,7 +9,8 @@ use std::process::Output;
 
 use common::run_subdyn as subdyn;
 use subdyn::finetune::{
-    SurfaceFineTune, SurfaceFineTuneParams, SurfaceScheme, doo_sabin_to_non_uniform, edge_loops,
+    REFINEMENT_ITERATIONS, SurfaceFineTune, SurfaceFineTuneParams, SurfaceScheme,
+    doo_sabin_to_non_uniform, edge_loops,
 };
 use subdyn::math::{Point3, Vector3};
 use subdyn::topology::Level;
@@ -191,7 +192,7 @@ fn reusing_the_factor_reaches_the_same_surface() {
             .unwrap()
     };
     let (exact, r_exact) = solve(0);
-    let (reused, r_reused) = solve(10);
+    let (reused, r_reused) = solve(REFINEMENT_ITERATIONS);
     assert_eq!(r_exact.solver_timings.refined[0], 0);
     assert!(
         r_reused.solver_timings.refined[0] > 0,

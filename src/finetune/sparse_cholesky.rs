@@ -122,7 +122,10 @@ impl CholeskyPattern {
             c_rows.push(k);
             c_start[k + 1] = c_rows.len();
         }
-        let slot = |i: usize, j: usize| {
+        // Stored block of (row block, column block), row ≤ column, cached
+        // for the few block pairs of one group.
+        let mut cache: Vec<((usize, usize), usize)> = Vec::new();
+        let slot = |cache: &mut Vec<((usize, usize), usize)>, i: usize, j: usize| {
             let (pi, pj) = (place[i], place[j]);
             // In the block: (row unknown, column unknown); the diagonal
             // block keeps its upper triangle.
@@ -132,17 +135,30 @@ impl CholeskyPattern {
             } else {
                 (r, c)
             };
-            let s = c_start[col];
-            let blk = s + c_rows[s..c_start[col + 1]].partition_point(|&x| x < row);
+            let blk = match cache.iter().find(|e| e.0 == (row, col)) {
+                Some(e) => e.1,
+                None => {
+                    let s = c_start[col];
+                    let blk = s + c_rows[s..c_start[col + 1]].partition_point(|&x| x < row);
+                    cache.push(((row, col), blk));
+                    blk
+                }
+            };
             9 * blk + 3 * r + c
         };
         let mut slots = Vec::new();
         for group in groups {
             for (p, &i) in group.iter().enumerate() {
-                slots.extend(group[p..].iter().map(|&j| slot(i, j)));
+                for &j in &group[p..] {
+                    slots.push(slot(&mut cache, i, j));
+                }
             }
+            cache.clear();
         }
-        slots.extend((0..n).map(|i| slot(i, i)));
+        for i in 0..n {
+            slots.push(slot(&mut cache, i, i));
+            cache.clear();
+        }
         let parent = elimination_tree(nb, &c_start, &c_rows);
         let mut counts = vec![1usize; nb];
         let mut mark = vec![usize::MAX; nb];

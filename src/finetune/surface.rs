@@ -50,7 +50,7 @@ pub struct SurfaceFineTuneParams {
     pub method: FinetuneMethod,
     /// Levenberg-Marquardt: conjugate-gradient iterations allowed to solve a
     /// step with the previous factorisation before factoring afresh
-    /// (`refined_step`); default [`REFINEMENT_ITERATIONS`] (10), 0 factors
+    /// (`refined_step`); default [`REFINEMENT_ITERATIONS`] (15), 0 factors
     /// every step.
     pub refinement_iterations: usize,
 }
