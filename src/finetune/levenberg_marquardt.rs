@@ -6,7 +6,15 @@
 //! `g = 2 Jᵀ r` and `H = 2 Jᵀ J` each step solves
 //! `(H + λ D) δ = −g`, `D = diag(H)` (Marquardt 1963; floored at `1e-12`
 //! of its largest entry so that it is positive definite), by the sparse
-//! Cholesky of `sparse_cholesky` (pattern and ordering computed once). A step
+//! Cholesky of `sparse_cholesky` (pattern and ordering computed once).
+//! After the first factorisation a step is first solved by conjugate
+//! gradients preconditioned with the last factor (`refined_step`,
+//! [`LmParams::refinement_iterations`]) and factored afresh only if that
+//! does not converge: on the benchmark surface one factorisation and about
+//! 11 CG iterations per later step instead of four factorisations. Rows
+//! sharing their variables (an angle and its curvature rows) have their
+//! `JᵀJ` summed densely before it is scattered into the factor's slots;
+//! [`LmTimings`] records where the time goes. A step
 //! is accepted only if it lowers `E`, so the recorded energies never rise;
 //! `λ` starts at [`LAMBDA_START`] (nearly a Gauss-Newton step: `D` makes
 //! it relative) and follows Nielsen's rule (Madsen, Nielsen, Tingleff,
