@@ -1,7 +1,10 @@
 //! Criterion bench of surface fine tuning end to end on a 1,000-edge
-//! Doo-Sabin mesh (issue 8's goal: under 100 ms), with two baselines measured
-//! in the same run: the precompute alone (conversion, loops, targets) and one
-//! energy-and-gradient evaluation.
+//! Doo-Sabin mesh (issue 8's goal: under 100 ms), with baselines measured
+//! in the same run: Levenberg-Marquardt factoring every step
+//! (`refinement_iterations: 0`, the earlier solver's linear algebra), the
+//! precompute alone (conversion, loops, targets) and one energy-and-gradient
+//! evaluation. The printed lines give each run's phase timings
+//! (`LmTimings`).
 //!
 //! Inputs: `subdyn::examples::torus(20, 25, 2.0, 0.7)` (500 quads, 1,000
 //! edges) read as a Doo-Sabin mesh; the 25 edges of one meridian get control
@@ -26,6 +29,10 @@ fn fine_tuning(c: &mut Criterion) {
     let values: Vec<(u32, u32, f64)> = (0..m).map(|j| (id(0, j), id(0, j + 1), 1.3)).collect();
     let fixed: Vec<u32> = (0..m).map(|j| id(n / 2, j)).collect();
     let params = SurfaceFineTuneParams::default();
+    let every_step = SurfaceFineTuneParams {
+        refinement_iterations: 0,
+        ..Default::default()
+    };
     let ncg = SurfaceFineTuneParams {
         max_iters: 200,
         method: FinetuneMethod::NonlinearCg,
@@ -37,20 +44,22 @@ fn fine_tuning(c: &mut Criterion) {
     };
     let problem = SurfaceFineTune::new(&mesh, SurfaceScheme::DooSabin, &values, &fixed, &params)
         .expect("a torus is a valid Doo-Sabin mesh");
-    for p in [&params, &ncg, &ncg_full] {
+    for p in [&params, &every_step, &ncg, &ncg_full] {
         let run = SurfaceFineTune::new(&mesh, SurfaceScheme::DooSabin, &values, &fixed, p)
             .expect("precompute");
         let (_, report) = run.solve().expect("solve");
         eprintln!(
-            "1,000-edge torus, {:?}, at most {} iterations: {} converted vertices, {} iterations ({}), energy {:.3e} -> {:.6e}, {:.3} s",
+            "1,000-edge torus, {:?} (refinement {}), at most {} iterations: {} converted vertices, {} iterations ({}), energy {:.3e} -> {:.12e}, {:.3} s, {:?}",
             p.method,
+            p.refinement_iterations,
             p.max_iters,
             problem.mesh.num_vertices(),
             report.iterations,
             report.termination,
             report.energies[0],
             report.energies.last().copied().unwrap_or(0.0),
-            report.seconds[1]
+            report.seconds[1],
+            report.solver_timings
         );
     }
     let x: Vec<_> = problem.mesh.positions.clone();
@@ -64,6 +73,7 @@ fn fine_tuning(c: &mut Criterion) {
     let cube_case = (&cube, &cube_values[..], &cube_fixed[..]);
     for (name, (m, v, f), p) in [
         ("end_to_end_lm", torus_case, &params),
+        ("end_to_end_lm_factor_every_step", torus_case, &every_step),
         ("end_to_end_ncg_200_iters", torus_case, &ncg),
         ("cube_converged_lm", cube_case, &params),
         ("cube_converged_ncg", cube_case, &ncg_full),

@@ -2,7 +2,9 @@
 //! the factorisation solves random sparse SPD systems (mixed node sizes,
 //! padding and split nodes) to rounding; it refuses an indefinite matrix;
 //! LM lowers a small sum of squares monotonically to its minimum; and on a
-//! closed curve LM and argmin's nonlinear CG reach the same curve.
+//! closed curve LM and argmin's nonlinear CG reach the same curve. The
+//! product from the factor's slots and conjugate gradients preconditioned
+//! by another matrix's factor are checked against dense algebra.
 
 mod common;
 
@@ -13,7 +15,7 @@ use nalgebra::{DMatrix, DVector};
 
 use subdyn::finetune::{
     CholeskyPattern, CurveFinetune, CurveFinetuneParams, FinetuneMethod, LeastSquares, LmParams,
-    Residuals, alpha_from_values, levenberg_marquardt,
+    RELATIVE_RESIDUAL, Residuals, alpha_from_values, levenberg_marquardt, preconditioned_solution,
 };
 use subdyn::math::Point3;
 use subdyn::subdivision::{CurveScheme, CurveTopology};
@@ -55,6 +57,29 @@ fn random_system(rng: &mut Rng, n: usize, node_of: &[usize], groups: &[Vec<usize
         values[slots[s + i]] += 1.0;
     }
     let b: Vec<f64> = (0..n).map(|_| rng.uniform(-1.0, 1.0)).collect();
+    // The product from the slots is the dense product.
+    let ab = DVector::from_vec(pattern.product(&values, &b));
+    let want = &dense * DVector::from_vec(b.clone());
+    assert!((&ab - &want).norm() <= 1e-12 * (1.0 + want.norm()));
+    // Conjugate gradients preconditioned by the factor of a perturbed matrix
+    // (diagonal × 1.3) reach the solution; with one iteration they do not.
+    if n > 2 {
+        let mut other = values.clone();
+        for i in 0..n {
+            other[slots[s + i]] = 1.3 * values[slots[s + i]] + 0.2;
+        }
+        let m = pattern.factor(&other).expect("SPD");
+        let (x, its) = preconditioned_solution(&pattern, &values, &m, &b, 60);
+        let x = x.expect("converges");
+        let r = &dense * DVector::from_vec(x) - DVector::from_vec(b.clone());
+        assert!(r.norm() <= 2.0 * RELATIVE_RESIDUAL * DVector::from_vec(b.clone()).norm());
+        assert!(its > 1, "{its} iterations");
+        assert!(
+            preconditioned_solution(&pattern, &values, &m, &b, 1)
+                .0
+                .is_none()
+        );
+    }
     let x = pattern.factor(&values).expect("SPD").solution(&b);
     let residual = &dense * DVector::from_vec(x) - DVector::from_vec(b.clone());
     assert!(
@@ -140,6 +165,7 @@ fn levenberg_marquardt_lowers_the_energy_to_the_minimum() {
         max_iterations: 200,
         stall_window: 0,
         stall_relative: 0.0,
+        refinement_iterations: 0,
     };
     let run = levenberg_marquardt(&Rosenbrock, &[-1.2, 1.0, 3.0], &params);
     assert!(run.converged, "{}", run.termination);

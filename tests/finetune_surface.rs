@@ -9,7 +9,8 @@ use std::process::Output;
 
 use common::run_subdyn as subdyn;
 use subdyn::finetune::{
-    SurfaceFineTune, SurfaceFineTuneParams, SurfaceScheme, doo_sabin_to_non_uniform, edge_loops,
+    REFINEMENT_ITERATIONS, SurfaceFineTune, SurfaceFineTuneParams, SurfaceScheme,
+    doo_sabin_to_non_uniform, edge_loops,
 };
 use subdyn::math::{Point3, Vector3};
 use subdyn::topology::Level;
@@ -168,6 +169,50 @@ fn energy_decreases_and_fixed_vertices_stay_put() {
     assert_eq!(ratios.len(), 6);
     let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
     assert!(mean > 1.1, "legs at 1.3 grew only by {mean}");
+}
+
+/// Steps solved with the previous factor (`refinement_iterations`) reach the
+/// same minimum as factoring every step: same energy to 1e-10 (relative),
+/// same vertices to 1e-7 of the unit-cube scale, monotone energies.
+#[test]
+fn reusing_the_factor_reaches_the_same_surface() {
+    let (n, m) = (8usize, 6usize);
+    let mesh = subdyn::examples::torus(n, m, 2.0, 0.7);
+    let id = |i: usize, j: usize| ((i % n) * m + (j % m)) as u32;
+    let values: Vec<(u32, u32, f64)> = (0..m).map(|j| (id(0, j), id(0, j + 1), 1.3)).collect();
+    let fixed: Vec<u32> = (0..m).map(|j| id(n / 2, j)).collect();
+    let solve = |refinement_iterations| {
+        let params = SurfaceFineTuneParams {
+            refinement_iterations,
+            ..Default::default()
+        };
+        SurfaceFineTune::new(&mesh, SurfaceScheme::DooSabin, &values, &fixed, &params)
+            .unwrap()
+            .solve()
+            .unwrap()
+    };
+    let (exact, r_exact) = solve(0);
+    let (reused, r_reused) = solve(REFINEMENT_ITERATIONS);
+    assert_eq!(r_exact.solver_timings.refined[0], 0);
+    assert!(
+        r_reused.solver_timings.refined[0] > 0,
+        "no step was solved from an earlier factor: {:?}",
+        r_reused.solver_timings
+    );
+    assert!(r_reused.solver_timings.factorizations < r_exact.solver_timings.factorizations);
+    assert!(r_reused.energies.windows(2).all(|w| w[1] < w[0]));
+    let (e0, e1) = (
+        r_exact.energies.last().unwrap(),
+        r_reused.energies.last().unwrap(),
+    );
+    assert!((e0 - e1).abs() <= 1e-10 * e0, "energies {e0} vs {e1}");
+    let d = exact
+        .positions
+        .iter()
+        .zip(&reused.positions)
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(d < 1e-7 * 5.4, "vertices differ by {d}");
 }
 
 #[test]

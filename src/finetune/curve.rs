@@ -258,6 +258,8 @@ impl CurveFinetune {
                     max_iterations: self.params.max_iterations,
                     stall_window: 0,
                     stall_relative: 0.0,
+                    // The curve's systems are small: factoring is cheap.
+                    refinement_iterations: 0,
                 };
                 let run = levenberg_marquardt(&points, &vec![0.0; points.num_vars()], &lm);
                 let x = setup.problem.variables(&points.points(&run.z));

@@ -33,6 +33,7 @@ mod edge_loops;
 mod levenberg_marquardt;
 mod min_degree;
 mod nested_dissection;
+mod refined_step;
 mod sparse_cholesky;
 mod surface;
 mod surface_energy;
@@ -52,8 +53,10 @@ pub use curve_io::{curve_json, read_alpha, read_curve, write_json};
 pub use curve_picture::{CurveLayer, comparison_layers, curve_layer, curve_picture};
 pub use edge_loops::{EdgeLoop, edge_loops};
 pub use levenberg_marquardt::{
-    FinetuneMethod, LeastSquares, LmParams, LmRun, Residuals, levenberg_marquardt,
+    FinetuneMethod, LeastSquares, LmParams, LmRun, LmTimings, REFINEMENT_ITERATIONS, Residuals,
+    levenberg_marquardt,
 };
+pub use refined_step::{RELATIVE_RESIDUAL, preconditioned_solution};
 pub use sparse_cholesky::{Cholesky, CholeskyPattern};
 pub use surface::{SurfaceFineTune, SurfaceFineTuneParams, SurfaceFineTuneReport, SurfaceScheme};
 pub use surface_energy::{SpringEnergy, angle_and_gradients, joint_angles};

@@ -122,7 +122,10 @@ impl CholeskyPattern {
             c_rows.push(k);
             c_start[k + 1] = c_rows.len();
         }
-        let slot = |i: usize, j: usize| {
+        // Stored block of (row block, column block), row ≤ column, cached
+        // for the few block pairs of one group.
+        let mut cache: Vec<((usize, usize), usize)> = Vec::new();
+        let slot = |cache: &mut Vec<((usize, usize), usize)>, i: usize, j: usize| {
             let (pi, pj) = (place[i], place[j]);
             // In the block: (row unknown, column unknown); the diagonal
             // block keeps its upper triangle.
@@ -132,17 +135,30 @@ impl CholeskyPattern {
             } else {
                 (r, c)
             };
-            let s = c_start[col];
-            let blk = s + c_rows[s..c_start[col + 1]].partition_point(|&x| x < row);
+            let blk = match cache.iter().find(|e| e.0 == (row, col)) {
+                Some(e) => e.1,
+                None => {
+                    let s = c_start[col];
+                    let blk = s + c_rows[s..c_start[col + 1]].partition_point(|&x| x < row);
+                    cache.push(((row, col), blk));
+                    blk
+                }
+            };
             9 * blk + 3 * r + c
         };
         let mut slots = Vec::new();
         for group in groups {
             for (p, &i) in group.iter().enumerate() {
-                slots.extend(group[p..].iter().map(|&j| slot(i, j)));
+                for &j in &group[p..] {
+                    slots.push(slot(&mut cache, i, j));
+                }
             }
+            cache.clear();
         }
-        slots.extend((0..n).map(|i| slot(i, i)));
+        for i in 0..n {
+            slots.push(slot(&mut cache, i, i));
+            cache.clear();
+        }
         let parent = elimination_tree(nb, &c_start, &c_rows);
         let mut counts = vec![1usize; nb];
         let mut mark = vec![usize::MAX; nb];
@@ -177,6 +193,31 @@ impl CholeskyPattern {
     /// Stored 3 × 3 blocks of the factor `L`.
     pub fn factor_blocks(&self) -> usize {
         self.l_start[self.l_start.len() - 1]
+    }
+
+    /// The product `A x` of the symmetric matrix whose upper triangle (in
+    /// the slots returned by [`new`](Self::new)) is `values` with `x`.
+    pub fn product(&self, values: &[Real], x: &[Real]) -> Vec<Real> {
+        let nb = self.l_start.len() - 1;
+        let mut xb = vec![Vector3::zeros(); nb];
+        for (i, &(blk, k)) in self.place.iter().enumerate() {
+            xb[blk][k] = x[i];
+        }
+        let block = |p: usize| Matrix3::from_fn(|r, c| values[9 * p + 3 * r + c]);
+        let mut y = vec![Vector3::zeros(); nb];
+        for k in 0..nb {
+            let last = self.c_start[k + 1] - 1;
+            for p in self.c_start[k]..last {
+                let (b, i) = (block(p), self.c_rows[p]);
+                y[i] += b * xb[k];
+                y[k] += b.tr_mul(&xb[i]);
+            }
+            // The diagonal block keeps its upper triangle.
+            let u = block(last);
+            let full = Matrix3::from_fn(|r, c| if r <= c { u[(r, c)] } else { u[(c, r)] });
+            y[k] += full * xb[k];
+        }
+        self.place.iter().map(|&(blk, k)| y[blk][k]).collect()
     }
 
     /// The factor of the matrix whose upper triangle (in the slots returned by

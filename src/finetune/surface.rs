@@ -13,7 +13,7 @@ use crate::math::{Point3, Real, bounding_box};
 use crate::mesh::PolyMesh;
 use crate::topology::{Level, find_edge};
 
-use super::levenberg_marquardt::FinetuneMethod;
+use super::levenberg_marquardt::{FinetuneMethod, LmTimings, REFINEMENT_ITERATIONS};
 use super::surface_energy::{SpringEnergy, joint_angles};
 use super::surface_solve::minimise;
 use super::surface_targets::{LegKind, loop_targets};
@@ -48,6 +48,11 @@ pub struct SurfaceFineTuneParams {
     /// The minimiser; default Levenberg-Marquardt (`surface_gauss_newton`),
     /// [`FinetuneMethod::NonlinearCg`] is argmin's nonlinear CG.
     pub method: FinetuneMethod,
+    /// Levenberg-Marquardt: conjugate-gradient iterations allowed to solve a
+    /// step with the previous factorisation before factoring afresh
+    /// (`refined_step`); default [`REFINEMENT_ITERATIONS`] (15), 0 factors
+    /// every step.
+    pub refinement_iterations: usize,
 }
 
 impl Default for SurfaceFineTuneParams {
@@ -60,6 +65,7 @@ impl Default for SurfaceFineTuneParams {
             energy_tolerance: 1e-5,
             prescale: true,
             method: FinetuneMethod::default(),
+            refinement_iterations: REFINEMENT_ITERATIONS,
         }
     }
 }
@@ -83,6 +89,8 @@ pub struct SurfaceFineTuneReport {
     pub max_displacement: Real,
     /// Seconds for the precompute and the solve.
     pub seconds: [f64; 2],
+    /// Where Levenberg-Marquardt spent the solve (zero for nonlinear CG).
+    pub solver_timings: LmTimings,
 }
 
 /// A precomputed fine-tuning problem; [`solve`](Self::solve) minimises it.
@@ -261,6 +269,7 @@ impl SurfaceFineTune {
             counts: self.counts,
             max_displacement,
             seconds: [self.seconds, start.elapsed().as_secs_f64()],
+            solver_timings: run.timings,
         };
         Ok((out, report))
     }

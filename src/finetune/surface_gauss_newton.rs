@@ -59,14 +59,14 @@ impl<'a> SurfacePointProblem<'a> {
 
     /// Appends residual `r` with vertex gradients `(vertex, ∂r/∂x)`.
     fn push(&self, out: &mut Residuals, r: Real, grads: &[(u32, Vector3)]) {
-        out.push(
-            r,
-            grads.iter().flat_map(|&(v, g)| {
-                self.var_of[v as usize]
-                    .into_iter()
-                    .flat_map(move |base| (0..3).map(move |c| (base + c, g[c])))
-            }),
-        );
+        for &(v, g) in grads {
+            if let Some(base) = self.var_of[v as usize] {
+                out.vars.extend_from_slice(&[base, base + 1, base + 2]);
+                out.grads.extend_from_slice(&[g.x, g.y, g.z]);
+            }
+        }
+        out.values.push(r);
+        out.start.push(out.vars.len());
     }
 }
 

@@ -25,7 +25,9 @@ use crate::error::{Error, Result};
 use crate::math::{Point3, Real};
 
 use super::SurfaceFineTuneParams;
-use super::levenberg_marquardt::{FinetuneMethod, LeastSquares, LmParams, levenberg_marquardt};
+use super::levenberg_marquardt::{
+    FinetuneMethod, LeastSquares, LmParams, LmTimings, levenberg_marquardt,
+};
 use super::surface_energy::SpringEnergy;
 use super::surface_gauss_newton::SurfacePointProblem;
 
@@ -41,6 +43,8 @@ pub struct Minimised {
     pub iterations: u64,
     /// Why it stopped.
     pub termination: String,
+    /// Phase timings of Levenberg-Marquardt (zero for nonlinear CG).
+    pub timings: LmTimings,
 }
 
 type Param = DVector<Real>;
@@ -184,6 +188,7 @@ pub fn minimise(
             gradient_norms: Vec::new(),
             iterations: 0,
             termination: "nothing to do".into(),
+            timings: LmTimings::default(),
         });
     }
     if params.method == FinetuneMethod::LevenbergMarquardt {
@@ -193,6 +198,7 @@ pub fn minimise(
             max_iterations: params.max_iters,
             stall_window: STALL_WINDOW,
             stall_relative: params.energy_tolerance,
+            refinement_iterations: params.refinement_iterations,
         };
         let run = levenberg_marquardt(&problem, &vec![0.0; problem.num_vars()], &lm);
         return Ok(Minimised {
@@ -201,6 +207,7 @@ pub fn minimise(
             gradient_norms: run.gradient_norms,
             iterations: run.iterations,
             termination: run.termination,
+            timings: run.timings,
         });
     }
     let linesearch = MoreThuenteLineSearch::new()
@@ -262,6 +269,7 @@ pub fn minimise(
         gradient_norms,
         iterations,
         termination,
+        timings: LmTimings::default(),
     })
 }
 
