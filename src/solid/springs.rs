@@ -99,6 +99,24 @@ pub struct SpringHessians {
     virtuals: Vec<[Real; 5]>,
 }
 
+/// The `3 × 3` matrix of a Hessian stored by [`hessian`]: `k_t I + (k − k_t) u uᵀ`.
+fn hessian_matrix(h: &[Real; 5]) -> nalgebra::Matrix3<Real> {
+    let u = Vector3::new(h[0], h[1], h[2]);
+    nalgebra::Matrix3::identity() * h[4] + u * u.transpose() * (h[3] - h[4])
+}
+
+impl SpringHessians {
+    /// The `3 × 3` Hessian of edge spring `s`.
+    pub fn edge_matrix(&self, s: usize) -> nalgebra::Matrix3<Real> {
+        hessian_matrix(&self.edges[s])
+    }
+
+    /// The `3 × 3` Hessian of virtual spring `s`.
+    pub fn virtual_matrix(&self, s: usize) -> nalgebra::Matrix3<Real> {
+        hessian_matrix(&self.virtuals[s])
+    }
+}
+
 /// Splits `0..n` into one contiguous range per worker and sums the per-range
 /// accumulations of `body` into `out` (conflict-free parallel scatter).
 fn scatter_sum(
@@ -312,7 +330,21 @@ impl SpringNetwork {
                     self.face_offsets[f + 1] as usize,
                 );
                 let k = b - a;
-                if k <= 8 {
+                if k == 4 {
+                    // Quads (every face of a refined hexahedral lattice): fixed neighbours.
+                    let c = [0, 1, 2, 3].map(|i| self.virtuals[a + i][0] as usize);
+                    let wl = c.map(|i| w[i]);
+                    let mut yl = [Vector3::zeros(); 4];
+                    for (i, (p, n)) in [(3, 1), (0, 2), (1, 3), (2, 0)].into_iter().enumerate() {
+                        let y = hessian_times(&h.virtuals[a + i], wl[i] - 0.5 * (wl[p] + wl[n]));
+                        yl[i] += y;
+                        yl[p] -= 0.5 * y;
+                        yl[n] -= 0.5 * y;
+                    }
+                    for i in 0..4 {
+                        acc[c[i]] += yl[i];
+                    }
+                } else if k <= 8 {
                     // Corner i of the face is spring a + i, its neighbours i − 1 and i + 1.
                     let mut wl = [Vector3::zeros(); 8];
                     let mut yl = [Vector3::zeros(); 8];
