@@ -8,7 +8,7 @@
 //! `M̂ = A₁ᵀ M A₁`, `D̂ = γ M̂`, `K̂ = A₁ᵀ K A₁`, `K` the springs' and ropes'
 //! Hessian at `d` (transverse terms clamped, so the matrix is SPD), `f` the
 //! mass-point forces of [`Solid::step_explicit`]; then `ṗ₁ += Δṗ₁`,
-//! `p₁ += h ṗ₁`. CG starts from the previous step's `Δṗ₁` and runs matrix-free
+//! `p₁ += h ṗ₁`. CG runs matrix-free
 //! (one `A₁`, one Hessian and one `A₁ᵀ` product per iteration; the spring
 //! Hessians are computed once per step). Preconditioners
 //! ([`ImplicitPreconditioner`]):
@@ -17,11 +17,11 @@
 //!   at the step where it is built (which then converges in one iteration)
 //!   and reused, with the Hessian of that step, until a step needs more than
 //!   [`SolidParams::preconditioner_refresh`](super::SolidParams::preconditioner_refresh)
-//!   CG iterations; the next step rebuilds it;
+//!   CG iterations; the next step rebuilds it. CG starts from zero;
 //! - the spring Laplacian `P = (1 + hγ) M̂ + h² A₁ᵀ L A₁`,
 //!   `L = Σ k_s b_s b_sᵀ` (the rest-state Hessian with every spring direction
 //!   replaced by the identity), factored once per time step, material and
-//!   partition.
+//!   partition. CG starts from the previous step's `Δṗ₁`.
 //!
 //! Both are rebuilt when the time step, the material or the partition
 //! changes. The preconditioner changes only how fast CG reaches its
@@ -175,9 +175,12 @@ impl Solid {
             }
             mul_transpose_vectors(&self.part.a1, &fine)
         };
-        // Preconditioned CG, warm-started from the previous step's Δṗ₁.
+        // Preconditioned CG, from zero with the lagged Hessian (its first
+        // iterate `P⁻¹ b` is already close; a warm start would cost one more
+        // product), else warm-started from the previous step's Δṗ₁.
         let n = self.part.free.len();
-        let mut x = if self.last_dv.len() == n {
+        let warm = matches!(pre.factor, PrecondFactor::Laplacian(_));
+        let mut x = if self.last_dv.len() == n && warm {
             self.last_dv.clone()
         } else {
             vec![Vector3::zeros(); n]
