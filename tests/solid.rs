@@ -573,6 +573,20 @@ fn spring_hessian_is_the_derivative_of_the_spring_forces() {
     let e = net.add_forces(&x, k, &mut f);
     assert!(e > 0.0 && (e - net.energy(&x, k)).abs() < 1e-12 * e);
     assert!(f.iter().sum::<Vector3>().norm() < 1e-12 * scale);
+    // The implicit step's fused pass gives the same Hessians, forces − c K w
+    // and energy as the separate passes (on top of what `out` holds).
+    let c = 0.37;
+    let mut fused = vec![Vector3::new(1.0, -2.0, 0.5); x.len()];
+    let mut hess2 = SpringHessians::default();
+    let e2 = net.add_forces_minus_hessian_product(&x, &w, k, c, &mut fused, &mut hess2);
+    assert!((e2 - e).abs() < 1e-12 * e);
+    let mut kw2 = vec![Vector3::zeros(); x.len()];
+    net.add_hessian_product(&hess2, &w, &mut kw2);
+    for i in 0..x.len() {
+        let want = Vector3::new(1.0, -2.0, 0.5) + f[i] - kw[i] * c;
+        assert!((fused[i] - want).norm() < 1e-12 * scale, "point {i}");
+        assert!((kw2[i] - kw[i]).norm() < 1e-12 * scale, "point {i}");
+    }
 }
 
 #[test]

@@ -10,7 +10,8 @@
 //! mass-point forces of [`Solid::step_explicit`]; then `ṗ₁ += Δṗ₁`,
 //! `p₁ += h ṗ₁`. CG runs matrix-free
 //! (one `A₁`, one Hessian and one `A₁ᵀ` product per iteration; the spring
-//! Hessians are computed once per step). Preconditioners
+//! Hessians are computed once per step, in the same pass over the springs as
+//! the forces and `K ḋ`). Preconditioners
 //! ([`ImplicitPreconditioner`]):
 //! - the lagged Hessian (default): the step's own matrix
 //!   `A₁ᵀ ((1 + hγ) M + h² K) A₁` assembled densely ([`reduced`](super::reduced))
@@ -124,10 +125,26 @@ impl Solid {
     pub fn step_implicit(&mut self, h: Real) -> Result<StepReport> {
         check_step(self, h)?;
         let start = Instant::now();
-        let (f, spring_energy) = self.mass_point_forces();
+        // f − h K ḋ (forces, damping, ropes) and the Hessians in one pass.
+        let mut f: Vec<Vector3> = self
+            .mass
+            .iter()
+            .zip(&self.dd)
+            .map(|(m, v)| -self.params.damping * m * v)
+            .collect();
         let mut hess = std::mem::take(&mut self.hess);
-        self.springs
-            .hessians_into(&self.d, self.params.stiffness, &mut hess);
+        let spring_energy = self.springs.add_forces_minus_hessian_product(
+            &self.d,
+            &self.dd,
+            self.params.stiffness,
+            h,
+            &mut f,
+            &mut hess,
+        );
+        for r in &self.ropes {
+            f[r.point] +=
+                r.force_energy(&self.d).0 - r.hessian_times(&self.d, self.dd[r.point]) * h;
+        }
         let built = self.preconditioner(h, &hess);
         let result = self.solve_step(h, &f, &hess, built);
         self.hess = hess;
@@ -147,7 +164,7 @@ impl Solid {
     fn solve_step(
         &mut self,
         h: Real,
-        f: &[Vector3],
+        f_minus_hkv: &[Vector3],
         hess: &SpringHessians,
         built: Result<bool>,
     ) -> Result<(usize, Real, bool)> {
@@ -161,9 +178,8 @@ impl Solid {
         let nd = self.d.len();
         let scale = 1.0 + h * self.params.damping;
         let mut kw = vec![Vector3::zeros(); nd];
-        // b = h A₁ᵀ (f − h K ḋ)
-        self.stiffness_product(hess, &self.dd, &mut kw);
-        let rhs_fine: Vec<Vector3> = f.iter().zip(&kw).map(|(f, k)| (f - k * h) * h).collect();
+        // b = h A₁ᵀ (f − h K ḋ), `f_minus_hkv` holding the bracket.
+        let rhs_fine: Vec<Vector3> = f_minus_hkv.iter().map(|f| f * h).collect();
         let b = mul_transpose_vectors(&self.part.a1, &rhs_fine);
         let mut w = vec![Vector3::zeros(); nd];
         let mut fine = vec![Vector3::zeros(); nd];

@@ -308,6 +308,82 @@ impl SpringNetwork {
             .for_each(|(((o, s), &r), &l)| *o = hessian(virtual_delta(x, s), r, k.virtual_ * l));
     }
 
+    /// One pass for the implicit step's right-hand side: writes the
+    /// Hessians at `x` into `h` (as [`hessians_into`](Self::hessians_into)),
+    /// adds the forces `−∂E/∂x` minus `c K v` into `out` (as
+    /// [`add_forces`](Self::add_forces) followed by
+    /// [`add_hessian_product`](Self::add_hessian_product) of `−c v`) and
+    /// returns the spring energy. Each worker takes a contiguous share of the
+    /// edge and of the virtual springs.
+    pub fn add_forces_minus_hessian_product(
+        &self,
+        x: &[Point3],
+        v: &[Vector3],
+        k: Stiffness,
+        c: Real,
+        out: &mut [Vector3],
+        h: &mut SpringHessians,
+    ) -> Real {
+        let (ne, nv) = (self.edges.len(), self.virtuals.len());
+        h.edges.resize(ne, [0.0; 5]);
+        h.virtuals.resize(nv, [0.0; 5]);
+        let parts = rayon::current_num_threads()
+            .clamp(1, 8)
+            .min((ne + nv).div_ceil(2048).max(1));
+        let (ce, cv) = (ne.div_ceil(parts), nv.div_ceil(parts));
+        let mut shares = Vec::with_capacity(parts);
+        let (mut he, mut hv) = (&mut h.edges[..], &mut h.virtuals[..]);
+        for p in 0..parts {
+            let (a, rest_e) = std::mem::take(&mut he).split_at_mut(ce.min(ne - (p * ce).min(ne)));
+            let (b, rest_v) = std::mem::take(&mut hv).split_at_mut(cv.min(nv - (p * cv).min(nv)));
+            shares.push((p, a, b));
+            he = rest_e;
+            hv = rest_v;
+        }
+        let results: Vec<(Vec<Vector3>, Real)> = shares
+            .into_par_iter()
+            .map(|(p, he, hv)| {
+                let mut acc = vec![Vector3::zeros(); self.num_points];
+                let mut energy = 0.0;
+                for (i, o) in he.iter_mut().enumerate() {
+                    let s = p * ce + i;
+                    let e = &self.edges[s];
+                    let d = edge_delta(x, e);
+                    let kk = k.edge * self.edge_scale[s];
+                    let (t, en) = tension(d, self.edge_rest[s], kk);
+                    *o = hessian(d, self.edge_rest[s], kk);
+                    let y = t + hessian_times(o, v[e[0] as usize] - v[e[1] as usize]) * c;
+                    acc[e[0] as usize] -= y;
+                    acc[e[1] as usize] += y;
+                    energy += en;
+                }
+                for (i, o) in hv.iter_mut().enumerate() {
+                    let s = p * cv + i;
+                    let e = &self.virtuals[s];
+                    let d = virtual_delta(x, e);
+                    let kk = k.virtual_ * self.virtual_scale[s];
+                    let (t, en) = tension(d, self.virtual_rest[s], kk);
+                    *o = hessian(d, self.virtual_rest[s], kk);
+                    let dv = v[e[0] as usize] - 0.5 * (v[e[1] as usize] + v[e[2] as usize]);
+                    let y = t + hessian_times(o, dv) * c;
+                    acc[e[0] as usize] -= y;
+                    acc[e[1] as usize] += 0.5 * y;
+                    acc[e[2] as usize] += 0.5 * y;
+                    energy += en;
+                }
+                (acc, energy)
+            })
+            .collect();
+        let mut energy = 0.0;
+        for (acc, e) in results {
+            energy += e;
+            for (o, a) in out.iter_mut().zip(acc) {
+                *o += a;
+            }
+        }
+        energy
+    }
+
     /// Adds `K w` into `out` with the Hessians of [`hessians_into`](Self::hessians_into).
     /// Virtual springs are processed face by face: a face's corners are read
     /// and written once for all its springs.
