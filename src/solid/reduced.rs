@@ -14,8 +14,9 @@
 //!    ([`BlockPattern`], built once per topology): a spring `Δ = Σ b_i x_i`
 //!    with Hessian `H` adds `b_i b_j H` to block `(i, j)`;
 //! 2. per mass point `i`, the `3 × 3n` row block `Y_i = Σ_j B_ij (A₁[j] ⊗ I₃)`,
-//!    then `P += A₁[i]ᵀ ⊗ Y_i`, the points split over the workers, each with
-//!    its own `3n × 3n` accumulator.
+//!    then `P += A₁[i]ᵀ ⊗ Y_i` (only the blocks on and right of the
+//!    diagonal; `P` is symmetric), the points split over the workers, each
+//!    with its own `3n × 3n` accumulator.
 //!
 //! Cost `O(N · (neighbours · nnz(A₁ row) · 9 + nnz(A₁ row) · 9n))`: about
 //! 35 M multiply-adds for the 4,913-point cube, against about 1 M for one
@@ -188,10 +189,12 @@ pub(crate) fn reduced_matrix(
                 }
                 let (ci, wi) = a1.row(i);
                 for (&c, &v) in ci.iter().zip(wi) {
+                    // P is symmetric: only the blocks right of the diagonal.
+                    let c0 = 3 * c as usize;
                     for al in 0..3 {
-                        let r = (3 * c as usize + al) * n3;
-                        let src = &y[al * n3..(al + 1) * n3];
-                        for (o, s) in acc[r..r + n3].iter_mut().zip(src) {
+                        let r = (c0 + al) * n3;
+                        let src = &y[al * n3 + c0..(al + 1) * n3];
+                        for (o, s) in acc[r + c0..r + n3].iter_mut().zip(src) {
                             *o += v * s;
                         }
                     }
@@ -204,6 +207,14 @@ pub(crate) fn reduced_matrix(
     for acc in partial {
         for (o, a) in sum.iter_mut().zip(acc) {
             *o += a;
+        }
+    }
+    // Mirror the upper block triangle (rows of block c hold columns ≥ 3c).
+    for r in 0..n3 {
+        for col in 3 * (r / 3)..n3 {
+            if col / 3 > r / 3 {
+                sum[col * n3 + r] = sum[r * n3 + col];
+            }
         }
     }
     DMatrix::from_row_slice(n3, n3, &sum)
