@@ -16,9 +16,10 @@
 //! - the lagged Hessian (default): the step's own matrix
 //!   `A₁ᵀ ((1 + hγ) M + h² K) A₁` assembled densely ([`reduced`](super::reduced))
 //!   at the step where it is built (which then converges in one iteration)
-//!   and reused, with the Hessian of that step, until a step needs more than
-//!   [`SolidParams::preconditioner_refresh`](super::SolidParams::preconditioner_refresh)
-//!   CG iterations; the next step rebuilds it. CG starts from zero;
+//!   and reused, with the Hessian of that step, until the CG iterations
+//!   beyond the first, summed since then, exceed
+//!   [`SolidParams::preconditioner_refresh`](super::SolidParams::preconditioner_refresh);
+//!   the next step rebuilds it. CG starts from zero;
 //! - the spring Laplacian `P = (1 + hγ) M̂ + h² A₁ᵀ L A₁`,
 //!   `L = Σ k_s b_s b_sᵀ` (the rest-state Hessian with every spring direction
 //!   replaced by the identity), factored once per time step, material and
@@ -107,6 +108,7 @@ impl Solid {
         self.precond = Some(Preconditioner {
             h,
             factor,
+            excess: 0,
             stale: false,
         });
         Ok(true)
@@ -248,8 +250,9 @@ impl Solid {
             }
         }
         if let Some(p) = self.precond.as_mut() {
+            p.excess += iterations.saturating_sub(1);
             p.stale = matches!(p.factor, PrecondFactor::Hessian(_))
-                && iterations > self.params.preconditioner_refresh;
+                && p.excess > self.params.preconditioner_refresh;
         }
         for (k, &i) in self.part.free.iter().enumerate() {
             self.v[i] += x[k];

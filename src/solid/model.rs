@@ -52,6 +52,8 @@ pub(crate) struct Preconditioner {
     pub h: Real,
     /// Its factor.
     pub factor: PrecondFactor,
+    /// CG iterations beyond the first, summed over the steps since it was built.
+    pub excess: usize,
     /// Rebuild it at the next step (the lagged Hessian has drifted).
     pub stale: bool,
 }

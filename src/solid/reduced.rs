@@ -6,8 +6,9 @@
 //! This is exactly the matrix the CG of the implicit step applies
 //! matrix-free, so its Cholesky factor, taken at one step's Hessian, solves
 //! that step in one CG iteration and preconditions the following steps
-//! while the Hessian drifts (the implicit step refreshes it when CG needs
-//! more iterations than [`SolidParams::preconditioner_refresh`](super::SolidParams::preconditioner_refresh)).
+//! while the Hessian drifts (the implicit step refreshes it when their CG
+//! iterations beyond the first add up to more than
+//! [`SolidParams::preconditioner_refresh`](super::SolidParams::preconditioner_refresh)).
 //!
 //! Assembly, for `N` mass points and `n` free control points:
 //! 1. `B` as `3 × 3` blocks on the spring network's block pattern
