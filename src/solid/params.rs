@@ -62,10 +62,10 @@ pub struct SolidParams {
     pub preconditioner: ImplicitPreconditioner,
     /// The lagged Hessian preconditioner is rebuilt at the next step once
     /// the CG iterations beyond the first, summed over the steps since it
-    /// was built, exceed this (default 10, about what a rebuild costs in CG
-    /// iterations on the 4,913-point cube: the wasted iterations then pay
-    /// for the next rebuild, the rule that balances the two when the
-    /// iterations grow steadily with the lag).
+    /// was built, exceed this (default 10; on the 4,913-point cube a rebuild
+    /// costs as much as some 10 to 30 CG iterations). Rebuilding once the
+    /// extra iterations have cost about one rebuild balances the two when
+    /// the iterations grow steadily with the lag.
     pub preconditioner_refresh: usize,
 }
 
