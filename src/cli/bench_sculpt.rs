@@ -16,7 +16,11 @@
 //! "implicit_ms", …}` on its own line; `mass_points` is ours, and
 //! `paper_mass_points` the paper's. `explicit_ms` and `implicit_ms` are
 //! median step times (`…_mean_ms` the means); `implicit_cg_iterations` the
-//! mean CG iterations per implicit step.
+//! mean CG iterations per implicit step and `implicit_refreshes` how many of
+//! the timed steps rebuilt the lagged Hessian preconditioner (its cost is in
+//! the mean). `implicit_laplacian_ms` (and `…_mean_ms`, `…_cg_iterations`)
+//! time the implicit step from the same state with the spring-Laplacian
+//! preconditioner, the one used before the lagged Hessian.
 
 use std::fmt::Write as _;
 
@@ -26,7 +30,7 @@ use serde_json::json;
 use subdyn::lattice::{Lattice, box_grid, extrude};
 use subdyn::math::{Point3, Real, Vector3};
 use subdyn::mesh::PolyMesh;
-use subdyn::solid::{Solid, SolidParams};
+use subdyn::solid::{ImplicitPreconditioner, Solid, SolidParams};
 
 use super::bench::set_threads;
 use super::common::{print_stdout, thousands, timed};
@@ -171,16 +175,23 @@ fn perturb(solid: &mut Solid) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Median and mean milliseconds per step, and mean CG iterations, over
-/// `steps` steps (the median resists the other jobs of a shared machine).
-fn time_steps(
-    solid: &mut Solid,
-    implicit: bool,
-    dt: Real,
-    steps: usize,
-) -> anyhow::Result<(Real, Real, Real)> {
+/// Median and mean step times over some steps.
+struct Timing {
+    /// Median milliseconds per step (resists the other jobs of a shared machine).
+    median: Real,
+    /// Mean milliseconds per step.
+    mean: Real,
+    /// Mean CG iterations per step.
+    iterations: Real,
+    /// Steps that rebuilt the implicit preconditioner.
+    refreshes: usize,
+}
+
+/// Times `steps` steps of one integrator.
+fn time_steps(solid: &mut Solid, implicit: bool, dt: Real, steps: usize) -> anyhow::Result<Timing> {
     let mut ms = Vec::with_capacity(steps);
     let mut iterations = 0usize;
+    let mut refreshes = 0usize;
     for _ in 0..steps {
         let r = if implicit {
             solid.step_implicit(dt)?
@@ -189,10 +200,16 @@ fn time_steps(
         };
         ms.push(1e3 * r.seconds);
         iterations += r.iterations;
+        refreshes += usize::from(r.refreshed);
     }
     let mean = ms.iter().sum::<Real>() / steps as Real;
     ms.sort_by(Real::total_cmp);
-    Ok((ms[steps / 2], mean, iterations as Real / steps as Real))
+    Ok(Timing {
+        median: ms[steps / 2],
+        mean,
+        iterations: iterations as Real / steps as Real,
+        refreshes,
+    })
 }
 
 /// Runs the benchmark: a table, then one JSON object per row.
@@ -220,7 +237,7 @@ pub fn bench_sculpt(args: &BenchSculptArgs) -> anyhow::Result<()> {
     );
     let _ = writeln!(
         table,
-        "{:<10} {:>5} {:>7} {:>7} {:>9} {:>11} {:>11} {:>8} {:>9} {:>8}",
+        "{:<10} {:>5} {:>7} {:>7} {:>9} {:>11} {:>11} {:>8} {:>9} {:>12} {:>8} {:>9} {:>8}",
         "model",
         "level",
         "points",
@@ -228,6 +245,9 @@ pub fn bench_sculpt(args: &BenchSculptArgs) -> anyhow::Result<()> {
         "paper ms",
         "explicit ms",
         "implicit ms",
+        "CG its",
+        "refreshes",
+        "laplacian ms",
         "CG its",
         "build ms",
         "speedup"
@@ -239,29 +259,46 @@ pub fn bench_sculpt(args: &BenchSculptArgs) -> anyhow::Result<()> {
             level: row.level,
             ..SolidParams::default()
         };
-        let (solid, build_s) = timed(|| Solid::new(&lattice, params));
+        let (solid, build_s) = timed(|| Solid::new(&lattice, params.clone()));
         let mut solid = solid?;
         let points = solid.mass_points().len();
         perturb(&mut solid)?;
-        let mut warm = solid.clone();
-        time_steps(&mut warm, false, args.dt, 3)?;
-        let (explicit_ms, explicit_mean, _) =
-            time_steps(&mut solid.clone(), false, args.dt, args.steps)?;
-        time_steps(&mut warm, true, 10.0 * args.dt, 1)?; // builds the preconditioner
-        let (implicit_ms, implicit_mean, cg) =
-            time_steps(&mut warm, true, 10.0 * args.dt, args.steps)?;
-        let speedup = row.paper_ms / explicit_ms;
+        let explicit = time_steps(&mut solid.clone(), false, args.dt, args.steps)?;
+        // Both preconditioners from the same state: three explicit steps,
+        // one untimed implicit step (the first factorisation), then `steps`.
+        let mut implicit = Vec::new();
+        for preconditioner in [
+            ImplicitPreconditioner::Laplacian,
+            ImplicitPreconditioner::LaggedHessian,
+        ] {
+            let mut warm = Solid::new(
+                &lattice,
+                SolidParams {
+                    preconditioner,
+                    ..params.clone()
+                },
+            )?;
+            perturb(&mut warm)?;
+            time_steps(&mut warm, false, args.dt, 3)?;
+            time_steps(&mut warm, true, 10.0 * args.dt, 1)?;
+            implicit.push(time_steps(&mut warm, true, 10.0 * args.dt, args.steps)?);
+        }
+        let (old, new) = (&implicit[0], &implicit[1]);
+        let speedup = row.paper_ms / explicit.median;
         let _ = writeln!(
             table,
-            "{:<10} {:>5} {:>7} {:>7} {:>9.0} {:>11.3} {:>11.3} {:>8.1} {:>9.1} {:>7.0}x{}",
+            "{:<10} {:>5} {:>7} {:>7} {:>9.0} {:>11.3} {:>11.3} {:>8.1} {:>9} {:>12.3} {:>8.1} {:>9.1} {:>7.0}x{}",
             row.model,
             row.level,
             thousands(points),
             thousands(row.paper_points),
             row.paper_ms,
-            explicit_ms,
-            implicit_ms,
-            cg,
+            explicit.median,
+            new.median,
+            new.iterations,
+            new.refreshes,
+            old.median,
+            old.iterations,
             1e3 * build_s,
             speedup,
             if points == row.paper_points {
@@ -278,12 +315,16 @@ pub fn bench_sculpt(args: &BenchSculptArgs) -> anyhow::Result<()> {
                 "level": row.level,
                 "mass_points": points,
                 "paper_ms": row.paper_ms,
-                "explicit_ms": explicit_ms,
-                "implicit_ms": implicit_ms,
+                "explicit_ms": explicit.median,
+                "implicit_ms": new.median,
                 "paper_mass_points": row.paper_points,
-                "explicit_mean_ms": explicit_mean,
-                "implicit_mean_ms": implicit_mean,
-                "implicit_cg_iterations": cg,
+                "explicit_mean_ms": explicit.mean,
+                "implicit_mean_ms": new.mean,
+                "implicit_cg_iterations": new.iterations,
+                "implicit_refreshes": new.refreshes,
+                "implicit_laplacian_ms": old.median,
+                "implicit_laplacian_mean_ms": old.mean,
+                "implicit_laplacian_cg_iterations": old.iterations,
                 "build_ms": 1e3 * build_s,
                 "explicit_speedup": speedup,
             })

@@ -24,6 +24,8 @@ pub struct StepReport {
     pub residual: Real,
     /// Spring energy at the start of the step.
     pub spring_energy: Real,
+    /// The implicit step (re)built its preconditioner.
+    pub refreshed: bool,
 }
 
 /// Errors unless `h` is a usable time step and the state is finite.
@@ -69,6 +71,7 @@ impl Solid {
             iterations: 0,
             residual: 0.0,
             spring_energy,
+            refreshed: false,
         })
     }
 }

@@ -50,8 +50,21 @@ pub(crate) struct Partition {
 pub(crate) struct Preconditioner {
     /// The time step it was built for.
     pub h: Real,
-    /// Factor of `(1 + hγ) A₁ᵀ M A₁ + h² A₁ᵀ L A₁`.
-    pub factor: Cholesky<Real, Dyn>,
+    /// Its factor.
+    pub factor: PrecondFactor,
+    /// CG iterations beyond the first, summed over the steps since it was built.
+    pub excess: usize,
+    /// Rebuild it at the next step (the lagged Hessian has drifted).
+    pub stale: bool,
+}
+
+/// The factored preconditioner matrix.
+#[derive(Clone, Debug)]
+pub(crate) enum PrecondFactor {
+    /// `(1 + hγ) A₁ᵀ M A₁ + h² A₁ᵀ L A₁` (`n × n`, applied per coordinate).
+    Laplacian(Cholesky<Real, Dyn>),
+    /// `A₁ᵀ ((1 + hγ) M + h² K) A₁` at a past step (`3n × 3n`).
+    Hessian(Cholesky<Real, Dyn>),
 }
 
 /// A dynamic subdivision solid and its sculpting state.
@@ -78,6 +91,8 @@ pub struct Solid {
     pub(crate) last_dv: Vec<Vector3>,
     /// Buffers of the implicit step's spring Hessians.
     pub(crate) hess: super::springs::SpringHessians,
+    /// Block pattern of the spring Hessian (built when first needed).
+    pub(crate) pattern: Option<super::reduced::BlockPattern>,
     pub(crate) time: Real,
 }
 
@@ -127,6 +142,7 @@ impl Solid {
             precond: None,
             last_dv: Vec::new(),
             hess: Default::default(),
+            pattern: None,
             time: 0.0,
         };
         solid.rebuild_all()?;
@@ -147,6 +163,7 @@ impl Solid {
         let rest = self.a.apply(&self.p_rest)?;
         self.springs = SpringNetwork::new(&self.fine, &rest)?;
         self.mass = lumped_masses(&self.fine, &rest, self.params.density)?;
+        self.pattern = None;
         self.rebuild_partition()
     }
 

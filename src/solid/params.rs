@@ -21,6 +21,24 @@ pub enum ExplicitScheme {
     ForwardEuler,
 }
 
+/// The preconditioner of the implicit step's CG.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ImplicitPreconditioner {
+    /// The step's own matrix `A₁ᵀ ((1 + hγ) M + h² K) A₁`, assembled densely
+    /// at one step's Hessian, factored and reused by the following steps
+    /// until their CG iterations beyond the first add up to more than
+    /// [`preconditioner_refresh`](SolidParams::preconditioner_refresh)
+    /// (the default; used while there are at most
+    /// [`MAX_DENSE_UNKNOWNS`](super::MAX_DENSE_UNKNOWNS) unknowns, the
+    /// spring Laplacian beyond).
+    #[default]
+    LaggedHessian,
+    /// `(1 + hγ) A₁ᵀ M A₁ + h² A₁ᵀ L A₁`, `L = Σ k_s b_s b_sᵀ` the isotropic
+    /// spring Laplacian, one scalar system per coordinate, factored once per
+    /// time step, material and partition.
+    Laplacian,
+}
+
 /// Parameters of a [`Solid`](super::Solid).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SolidParams {
@@ -35,10 +53,20 @@ pub struct SolidParams {
     pub damping: Real,
     /// Explicit scheme (default [`ExplicitScheme::SymplecticEuler`]).
     pub scheme: ExplicitScheme,
-    /// Relative residual at which the implicit step's CG stops (default 1e-8).
+    /// Relative residual at which the implicit step's CG stops (default 1e-6).
     pub cg_tolerance: Real,
     /// CG iteration limit of the implicit step (default 500).
     pub cg_max_iterations: usize,
+    /// Preconditioner of the implicit step's CG (default
+    /// [`ImplicitPreconditioner::LaggedHessian`]).
+    pub preconditioner: ImplicitPreconditioner,
+    /// The lagged Hessian preconditioner is rebuilt at the next step once
+    /// the CG iterations beyond the first, summed over the steps since it
+    /// was built, exceed this (default 10; on the 4,913-point cube a rebuild
+    /// costs as much as some 10 to 30 CG iterations). Rebuilding once the
+    /// extra iterations have cost about one rebuild balances the two when
+    /// the iterations grow steadily with the lag.
+    pub preconditioner_refresh: usize,
 }
 
 impl Default for SolidParams {
@@ -54,6 +82,8 @@ impl Default for SolidParams {
             scheme: ExplicitScheme::SymplecticEuler,
             cg_tolerance: 1e-6,
             cg_max_iterations: 500,
+            preconditioner: ImplicitPreconditioner::LaggedHessian,
+            preconditioner_refresh: 10,
         }
     }
 }
@@ -73,7 +103,7 @@ pub(crate) fn check_value(name: &str, x: Real, positive: bool) -> Result<()> {
 impl SolidParams {
     /// Checks every value: level 0 to [`MAX_SOLID_LEVEL`], positive density,
     /// non-negative stiffnesses and damping, tolerance in (0, 1), 1 to 100,000
-    /// CG iterations.
+    /// CG iterations, a preconditioner refresh threshold of at least 1.
     pub fn check(&self) -> Result<()> {
         if self.level > MAX_SOLID_LEVEL {
             return Err(Error::Input(format!(
@@ -90,6 +120,11 @@ impl SolidParams {
                 "CG tolerance {} must lie in (0, 1)",
                 self.cg_tolerance
             )));
+        }
+        if self.preconditioner_refresh == 0 {
+            return Err(Error::Input(
+                "preconditioner refresh after 0 extra CG iterations: expected at least 1".into(),
+            ));
         }
         if self.cg_max_iterations == 0 || self.cg_max_iterations > 100_000 {
             return Err(Error::Input(format!(

@@ -78,12 +78,14 @@ pub fn dense(t: &StencilTable) -> DMatrix<Real> {
 
 /// Cholesky factor of a symmetric positive definite table (`what` names it in the error).
 pub fn cholesky(t: &StencilTable, what: &str) -> Result<Cholesky<Real, Dyn>> {
-    Cholesky::new(dense(t)).ok_or_else(|| {
-        Error::Input(format!(
-            "the {what} ({n}×{n}) is not positive definite",
-            n = t.num_rows()
-        ))
-    })
+    cholesky_dense(dense(t), what)
+}
+
+/// Cholesky factor of a symmetric positive definite matrix (`what` names it in the error).
+pub fn cholesky_dense(m: DMatrix<Real>, what: &str) -> Result<Cholesky<Real, Dyn>> {
+    let n = m.nrows();
+    Cholesky::new(m)
+        .ok_or_else(|| Error::Input(format!("the {what} ({n}×{n}) is not positive definite")))
 }
 
 /// Solves `P z = r` coordinate by coordinate with a factored scalar `P`.

@@ -99,6 +99,24 @@ pub struct SpringHessians {
     virtuals: Vec<[Real; 5]>,
 }
 
+/// The `3 × 3` matrix of a Hessian stored by [`hessian`]: `k_t I + (k − k_t) u uᵀ`.
+fn hessian_matrix(h: &[Real; 5]) -> nalgebra::Matrix3<Real> {
+    let u = Vector3::new(h[0], h[1], h[2]);
+    nalgebra::Matrix3::identity() * h[4] + u * u.transpose() * (h[3] - h[4])
+}
+
+impl SpringHessians {
+    /// The `3 × 3` Hessian of edge spring `s`.
+    pub fn edge_matrix(&self, s: usize) -> nalgebra::Matrix3<Real> {
+        hessian_matrix(&self.edges[s])
+    }
+
+    /// The `3 × 3` Hessian of virtual spring `s`.
+    pub fn virtual_matrix(&self, s: usize) -> nalgebra::Matrix3<Real> {
+        hessian_matrix(&self.virtuals[s])
+    }
+}
+
 /// Splits `0..n` into one contiguous range per worker and sums the per-range
 /// accumulations of `body` into `out` (conflict-free parallel scatter).
 fn scatter_sum(
@@ -290,6 +308,82 @@ impl SpringNetwork {
             .for_each(|(((o, s), &r), &l)| *o = hessian(virtual_delta(x, s), r, k.virtual_ * l));
     }
 
+    /// One pass for the implicit step's right-hand side: writes the
+    /// Hessians at `x` into `h` (as [`hessians_into`](Self::hessians_into)),
+    /// adds the forces `−∂E/∂x` minus `c K v` into `out` (as
+    /// [`add_forces`](Self::add_forces) followed by
+    /// [`add_hessian_product`](Self::add_hessian_product) of `−c v`) and
+    /// returns the spring energy. Each worker takes a contiguous share of the
+    /// edge and of the virtual springs.
+    pub fn add_forces_minus_hessian_product(
+        &self,
+        x: &[Point3],
+        v: &[Vector3],
+        k: Stiffness,
+        c: Real,
+        out: &mut [Vector3],
+        h: &mut SpringHessians,
+    ) -> Real {
+        let (ne, nv) = (self.edges.len(), self.virtuals.len());
+        h.edges.resize(ne, [0.0; 5]);
+        h.virtuals.resize(nv, [0.0; 5]);
+        let parts = rayon::current_num_threads()
+            .clamp(1, 8)
+            .min((ne + nv).div_ceil(2048).max(1));
+        let (ce, cv) = (ne.div_ceil(parts), nv.div_ceil(parts));
+        let mut shares = Vec::with_capacity(parts);
+        let (mut he, mut hv) = (&mut h.edges[..], &mut h.virtuals[..]);
+        for p in 0..parts {
+            let (a, rest_e) = std::mem::take(&mut he).split_at_mut(ce.min(ne - (p * ce).min(ne)));
+            let (b, rest_v) = std::mem::take(&mut hv).split_at_mut(cv.min(nv - (p * cv).min(nv)));
+            shares.push((p, a, b));
+            he = rest_e;
+            hv = rest_v;
+        }
+        let results: Vec<(Vec<Vector3>, Real)> = shares
+            .into_par_iter()
+            .map(|(p, he, hv)| {
+                let mut acc = vec![Vector3::zeros(); self.num_points];
+                let mut energy = 0.0;
+                for (i, o) in he.iter_mut().enumerate() {
+                    let s = p * ce + i;
+                    let e = &self.edges[s];
+                    let d = edge_delta(x, e);
+                    let kk = k.edge * self.edge_scale[s];
+                    let (t, en) = tension(d, self.edge_rest[s], kk);
+                    *o = hessian(d, self.edge_rest[s], kk);
+                    let y = t + hessian_times(o, v[e[0] as usize] - v[e[1] as usize]) * c;
+                    acc[e[0] as usize] -= y;
+                    acc[e[1] as usize] += y;
+                    energy += en;
+                }
+                for (i, o) in hv.iter_mut().enumerate() {
+                    let s = p * cv + i;
+                    let e = &self.virtuals[s];
+                    let d = virtual_delta(x, e);
+                    let kk = k.virtual_ * self.virtual_scale[s];
+                    let (t, en) = tension(d, self.virtual_rest[s], kk);
+                    *o = hessian(d, self.virtual_rest[s], kk);
+                    let dv = v[e[0] as usize] - 0.5 * (v[e[1] as usize] + v[e[2] as usize]);
+                    let y = t + hessian_times(o, dv) * c;
+                    acc[e[0] as usize] -= y;
+                    acc[e[1] as usize] += 0.5 * y;
+                    acc[e[2] as usize] += 0.5 * y;
+                    energy += en;
+                }
+                (acc, energy)
+            })
+            .collect();
+        let mut energy = 0.0;
+        for (acc, e) in results {
+            energy += e;
+            for (o, a) in out.iter_mut().zip(acc) {
+                *o += a;
+            }
+        }
+        energy
+    }
+
     /// Adds `K w` into `out` with the Hessians of [`hessians_into`](Self::hessians_into).
     /// Virtual springs are processed face by face: a face's corners are read
     /// and written once for all its springs.
@@ -312,7 +406,21 @@ impl SpringNetwork {
                     self.face_offsets[f + 1] as usize,
                 );
                 let k = b - a;
-                if k <= 8 {
+                if k == 4 {
+                    // Quads (every face of a refined hexahedral lattice): fixed neighbours.
+                    let c = [0, 1, 2, 3].map(|i| self.virtuals[a + i][0] as usize);
+                    let wl = c.map(|i| w[i]);
+                    let mut yl = [Vector3::zeros(); 4];
+                    for (i, (p, n)) in [(3, 1), (0, 2), (1, 3), (2, 0)].into_iter().enumerate() {
+                        let y = hessian_times(&h.virtuals[a + i], wl[i] - 0.5 * (wl[p] + wl[n]));
+                        yl[i] += y;
+                        yl[p] -= 0.5 * y;
+                        yl[n] -= 0.5 * y;
+                    }
+                    for i in 0..4 {
+                        acc[c[i]] += yl[i];
+                    }
+                } else if k <= 8 {
                     // Corner i of the face is spring a + i, its neighbours i − 1 and i + 1.
                     let mut wl = [Vector3::zeros(); 8];
                     let mut yl = [Vector3::zeros(); 8];
