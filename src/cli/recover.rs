@@ -22,6 +22,7 @@ use subdyn::subdivision::{RefineOptions, Refiner};
 use super::common::{
     about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, write_report,
 };
+use super::memory::{StagePeaks, peak_rss, stage_peak};
 use super::options::read_polygon_mesh;
 use super::progress::Progress;
 
@@ -170,21 +171,35 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     )
     .map_err(|e| about_file(e, &args.input))?;
     let read_s = seconds(t);
+    let read_peak = peak_rss();
     let volume = &file.volume;
     progress.stage("smoothing and edge detection");
-    let prepared = prepare_volume(volume, &params).map_err(|e| {
+    let (prepared, prepare_peak) = stage_peak(|| prepare_volume(volume, &params));
+    let prepared = prepared.map_err(|e| {
         anyhow::Error::new(e).context(format!("preparing {}", args.input.display()))
     })?;
     progress.stage("building the initial model");
     let t = Instant::now();
-    let (init, init_json) = initial_model(args, &prepared)?;
+    let (init, init_peak) = stage_peak(|| initial_model(args, &prepared));
+    let (init, init_json) = init?;
     let init_s = seconds(t);
     let mut on_step = |level: usize, step: usize, energy: f64| {
         progress.stage(format!("level {level}, step {step}: energy {energy:.4e}"));
     };
-    let result = recover_shape(&prepared, &init, &points, &params, &mut on_step).map_err(|e| {
+    let (result, evolution_peak) =
+        stage_peak(|| recover_shape(&prepared, &init, &points, &params, &mut on_step));
+    let result = result.map_err(|e| {
         anyhow::Error::new(e).context(format!("recovering from {}", args.input.display()))
     })?;
+    let memory = StagePeaks {
+        volume_bytes: 4 * volume.data().len() as u64,
+        stages: vec![
+            ("read", read_peak),
+            ("smoothing", prepare_peak),
+            ("initial model", init_peak),
+            ("evolution", evolution_peak),
+        ],
+    };
     progress.stage(format!("writing {}", args.output.display()));
     write_mesh(&args.output, &result.control, None).map_err(|e| about_file(e, &args.output))?;
     let surface = |mesh: &PolyMesh| -> anyhow::Result<(PolyMesh, Vec<subdyn::math::Vector3>)> {
@@ -222,12 +237,14 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
                 "evolution": result.report.levels.iter().map(|l| l.seconds).sum::<f64>(),
             },
             "recover": serde_json::to_value(&result.report)?,
+            "peak_memory": memory.json(),
             "slices": slice_files,
             "total_s": seconds(start),
         });
         write_report(path, &value)?;
     }
     let mut text = summary(args, &file.notes, read_s, init_s, &result.report);
+    text.push_str(&memory.line());
     if !slice_files.is_empty() {
         text.push_str(&format!(
             "slices: {} PNGs in {}\n",
