@@ -13,7 +13,8 @@
 //! ([`super::memory`]: the kernel's high-water mark, reset before the stage),
 //! against the volume's f32 size. The recovery's peak is the largest of
 //! synthesis (the input volume, which a real run reads instead),
-//! smoothing, initial cage and evolution; the accuracy check's own
+//! smoothing (in the input's own memory), initial cage and evolution; the
+//! accuracy check's own
 //! tessellation is reported apart.
 
 use std::fmt::Write as _;
@@ -22,7 +23,7 @@ use std::time::Instant;
 use clap::Args;
 use serde_json::json;
 
-use subdyn::fit::recover::{RecoverParams, component_cage, prepare_volume, recover_shape};
+use subdyn::fit::recover::{RecoverParams, component_cage, prepare_volume_owned, recover_shape};
 use subdyn::forces::BoundaryModel;
 use subdyn::limit::tessellate;
 use subdyn::math::{Point3, Real};
@@ -105,10 +106,10 @@ pub fn bench_recover(args: &BenchRecoverArgs) -> anyhow::Result<()> {
         ..Default::default()
     };
     // Every stage's peak resident memory is measured on its own (reset of
-    // the high-water mark before it); the input volume stays alive
-    // throughout, as in `subdyn recover`, which draws the slices from it.
+    // the high-water mark before it). The input is smoothed in its own
+    // memory and given up, as in `subdyn recover`.
     progress.stage("smoothing and force field");
-    let (prepared, prepare_peak) = stage_peak(|| prepare_volume(&volume, &params));
+    let (prepared, prepare_peak) = stage_peak(|| prepare_volume_owned(volume, &params));
     let prepared = prepared?;
     progress.stage("initial model");
     let t = Instant::now();

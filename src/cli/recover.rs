@@ -9,11 +9,11 @@ use clap::Args;
 use serde_json::json;
 
 use subdyn::fit::recover::{
-    PreparedVolume, RecoverParams, RecoverReport, component_cage, prepare_volume, recover_shape,
-    seed_cage,
+    PreparedVolume, RecoverParams, RecoverReport, component_cage, prepare_volume_owned,
+    recover_shape, seed_cage,
 };
 use subdyn::forces::BoundaryModel;
-use subdyn::io::{VolumeReadOptions, read_points, read_volume, write_mesh};
+use subdyn::io::{VolumeFile, VolumeReadOptions, read_points, read_volume, write_mesh};
 use subdyn::limit::tessellate;
 use subdyn::math::{Point3, Real};
 use subdyn::mesh::PolyMesh;
@@ -162,19 +162,23 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     let progress = Progress::new(args.quiet);
     progress.stage(format!("reading {}", args.input.display()));
     let t = Instant::now();
-    let file = read_volume(
-        &args.input,
-        &VolumeReadOptions {
-            spacing: args.spacing,
-            origin: args.origin,
-        },
-    )
-    .map_err(|e| about_file(e, &args.input))?;
+    let read_options = VolumeReadOptions {
+        spacing: args.spacing,
+        origin: args.origin,
+    };
+    let VolumeFile {
+        volume: input,
+        source,
+        notes,
+        ..
+    } = read_volume(&args.input, &read_options).map_err(|e| about_file(e, &args.input))?;
     let read_s = seconds(t);
     let read_peak = peak_rss();
-    let volume = &file.volume;
+    // The input is smoothed in its own memory and given up; the smoothed
+    // volume has the same grid, and --slices-png reads the input again.
+    let volume_bytes = 4 * input.data().len() as u64;
     progress.stage("smoothing and edge detection");
-    let (prepared, prepare_peak) = stage_peak(|| prepare_volume(volume, &params));
+    let (prepared, prepare_peak) = stage_peak(|| prepare_volume_owned(input, &params));
     let prepared = prepared.map_err(|e| {
         anyhow::Error::new(e).context(format!("preparing {}", args.input.display()))
     })?;
@@ -192,7 +196,7 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
         anyhow::Error::new(e).context(format!("recovering from {}", args.input.display()))
     })?;
     let memory = StagePeaks {
-        volume_bytes: 4 * volume.data().len() as u64,
+        volume_bytes,
         stages: vec![
             ("read", read_peak),
             ("smoothing", prepare_peak),
@@ -214,18 +218,22 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     if let Some(dir) = &args.slices_png {
         progress.stage("drawing slices");
         let (init_surf, _) = surface(&init)?;
-        slice_files = write_slices(dir, volume, &surf, &init_surf)?;
+        let image = read_volume(&args.input, &read_options)
+            .map_err(|e| about_file(e, &args.input))?
+            .volume;
+        slice_files = write_slices(dir, &image, &surf, &init_surf)?;
     }
     drop(progress);
     if let Some(path) = &args.report {
+        let grid = &prepared.smoothed;
         let value = json!({
             "command": "recover",
             "input": args.input.display().to_string(),
-            "format": file.source,
-            "notes": file.notes,
-            "dims": volume.dims(),
-            "spacing": volume.spacing(),
-            "origin": [volume.origin().x, volume.origin().y, volume.origin().z],
+            "format": source,
+            "notes": notes,
+            "dims": grid.dims(),
+            "spacing": grid.spacing(),
+            "origin": [grid.origin().x, grid.origin().y, grid.origin().z],
             "output": args.output.display().to_string(),
             "limit_out": args.limit_out.as_ref().map(|p| p.display().to_string()),
             "init": init_json,
@@ -243,7 +251,7 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
         });
         write_report(path, &value)?;
     }
-    let mut text = summary(args, &file.notes, read_s, init_s, &result.report);
+    let mut text = summary(args, &notes, read_s, init_s, &result.report);
     text.push_str(&memory.line());
     if !slice_files.is_empty() {
         text.push_str(&format!(
