@@ -6,7 +6,7 @@ mod common;
 use common::{default_refiner, reference_mesh};
 use subdyn::dynamics::{
     MaterialParams, PcgParams, damping_matrix, gauss_legendre, mass_matrix, patch_damping_matrix,
-    patch_samples, patch_stiffness_matrix, pcg, quadrature, stiffness_matrix,
+    patch_sample_rows, patch_samples, patch_stiffness_matrix, pcg, quadrature, stiffness_matrix,
 };
 use subdyn::limit::{LimitEvaluator, PatchTable, tessellate};
 use subdyn::math::{Point3, Real};
@@ -365,4 +365,97 @@ fn pcg_solves_spd_systems_and_reports() {
         )
         .is_err()
     );
+}
+
+/// Largest entry-wise difference of two tables with the same rows, and the
+/// largest entry of the first.
+fn table_difference(a: &StencilTable, b: &StencilTable) -> (Real, Real) {
+    assert_eq!(a.num_rows(), b.num_rows());
+    assert_eq!(a.num_cols, b.num_cols);
+    let (mut worst, mut scale) = (0.0f64, 0.0f64);
+    let mut row = vec![0.0; a.num_cols];
+    for r in 0..a.num_rows() {
+        let ((ca, wa), (cb, wb)) = (a.row(r), b.row(r));
+        for (&c, &w) in ca.iter().zip(wa) {
+            row[c as usize] += w;
+            scale = scale.max(w.abs());
+        }
+        for (&c, &w) in cb.iter().zip(wb) {
+            row[c as usize] -= w;
+        }
+        for x in row.iter_mut() {
+            worst = worst.max(x.abs());
+            *x = 0.0;
+        }
+    }
+    (worst, scale)
+}
+
+/// The first-derivative rows composed patch by patch equal `patch_samples`'
+/// level-`L` rows composed afterwards, on meshes with irregular vertices,
+/// boundaries and n-gons; positions form a partition of unity, tangents
+/// annihilate constants, and the weights sum to the base faces' area.
+#[test]
+fn sample_rows_equal_the_composed_patch_samples() {
+    for mesh in [
+        subdyn::examples::cube(),
+        reference_mesh("fan5_open"),
+        common::mixed_mesh(),
+    ] {
+        let r = default_refiner(&mesh);
+        let table = PatchTable::new(&r, &mesh.positions, 1).unwrap();
+        let rows = patch_sample_rows(&table, 3).unwrap();
+        let q = patch_samples(&table, 3).unwrap();
+        let s = table.to_level();
+        for (a, b, name) in [
+            (&q.rows.p, &rows.j, "J"),
+            (&q.rows.du, &rows.ju, "J_u"),
+            (&q.rows.dv, &rows.jv, "J_v"),
+        ] {
+            let (worst, scale) = table_difference(&a.compose(s).unwrap(), b);
+            assert!(
+                scale > 0.0 && worst <= 1e-13 * scale,
+                "{name}: differs by {worst:e} (largest entry {scale:e})"
+            );
+        }
+        assert_eq!(rows.weights, q.weights);
+        assert_eq!(rows.patch, q.patch);
+        for (t, one) in [(&rows.j, 1.0), (&rows.ju, 0.0), (&rows.jv, 0.0)] {
+            for (r, sum) in t.row_sums().iter().enumerate() {
+                assert!((sum - one).abs() < 1e-12, "row {r} sums to {sum}");
+            }
+        }
+        // The base faces' parameter area: every patch covers |det(axes)| of it.
+        let area: Real = (0..table.num_patches())
+            .map(|f| {
+                let a = table.patch_frame(f).1;
+                (a[0][0] * a[1][1] - a[0][1] * a[1][0]).abs()
+            })
+            .sum();
+        let total: Real = rows.weights.iter().sum();
+        assert!((total - area).abs() < 1e-12 * area, "{total} vs {area}");
+        assert!(patch_sample_rows(&table, 0).is_err());
+    }
+}
+
+/// `PatchTable::stencils` (a batch; an irregular patch's quadtree built for
+/// the call alone) gives exactly the stencils of `stencil` (which caches
+/// the quadtree), and the same again once the quadtree is cached.
+#[test]
+fn batched_stencils_equal_single_stencils() {
+    let mesh = common::mixed_mesh();
+    let r = default_refiner(&mesh);
+    let table = PatchTable::new(&r, &mesh.positions, 1).unwrap();
+    let sts = [[0.1, 0.2], [0.5, 0.5], [0.9, 0.03], [0.0, 0.0], [1.0, 0.7]];
+    for f in 0..table.num_patches() {
+        let batch = table.stencils(f, &sts);
+        let single: Vec<_> = sts.iter().map(|&st| table.stencil(f, st)).collect();
+        let cached = table.stencils(f, &sts);
+        for ((a, b), c) in batch.iter().zip(&single).zip(&cached) {
+            assert_eq!(a.cols, b.cols, "patch {f}");
+            assert_eq!(a.weights, b.weights, "patch {f}");
+            assert_eq!(c.cols, b.cols, "patch {f}");
+            assert_eq!(c.weights, b.weights, "patch {f}");
+        }
+    }
 }

@@ -4,7 +4,7 @@
 mod common;
 
 use subdyn::fit::recover::{
-    RecoverParams, component_cage, prepare_volume, recover_shape, seed_cage,
+    RecoverParams, component_cage, prepare_volume, prepare_volume_owned, recover_shape, seed_cage,
 };
 use subdyn::forces::BoundaryModel;
 use subdyn::limit::tessellate;
@@ -257,4 +257,38 @@ fn user_placed_points_pull_the_surface_where_the_image_says_otherwise() {
     let prepared = prepare_volume(&vol, &params).unwrap();
     let init = seed_cage(c, 4.0).unwrap();
     assert!(recover_shape(&prepared, &init, &bad, &params, &mut |_, _, _| {}).is_err());
+}
+
+/// Preparing a volume given up to the recovery (smoothed in its own
+/// memory) gives the same smoothed image, potential and inside level as
+/// preparing a borrowed one, and the same errors.
+#[test]
+fn an_owned_volume_is_prepared_like_a_borrowed_one() {
+    let c = Point3::new(8.0, 7.0, 9.0);
+    let vol = sdf_volume([17, 15, 19], [1.0, 1.0, 1.2], |p| (p - c).norm() - 4.5);
+    for boundary in [
+        BoundaryModel::Iso { value: 0.5 },
+        BoundaryModel::Edge { min_strength: 0.1 },
+    ] {
+        let params = RecoverParams {
+            boundary,
+            ..Default::default()
+        };
+        let a = prepare_volume(&vol, &params).unwrap();
+        let b = prepare_volume_owned(vol.clone(), &params).unwrap();
+        assert_eq!(a.smoothed.data(), b.smoothed.data());
+        assert_eq!(
+            a.potential.as_ref().map(|p| p.data()),
+            b.potential.as_ref().map(|p| p.data())
+        );
+        assert_eq!(a.inside_level, b.inside_level);
+        assert_eq!(a.sigma, b.sigma);
+    }
+    let flat = vol.with_data(vec![0.25; vol.data().len()]).unwrap();
+    assert!(prepare_volume_owned(flat, &RecoverParams::default()).is_err());
+    let params = RecoverParams {
+        boundary: BoundaryModel::Iso { value: 2.0 },
+        ..Default::default()
+    };
+    assert!(prepare_volume_owned(vol, &params).is_err());
 }

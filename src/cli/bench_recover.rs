@@ -8,6 +8,14 @@
 //! Gaussian noise of standard deviation `--noise` (a fixed-seed generator),
 //! 1 mm voxels. Accuracy is measured against the analytic distance on a
 //! K = 4 limit tessellation.
+//!
+//! Memory: the peak resident size of every stage on its own
+//! ([`super::memory`]: the kernel's high-water mark, reset before the stage),
+//! against the volume's f32 size. The recovery's peak is the largest of
+//! synthesis (the input volume, which a real run reads instead),
+//! smoothing (in the input's own memory), initial cage and evolution; the
+//! accuracy check's own
+//! tessellation is reported apart.
 
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -15,7 +23,7 @@ use std::time::Instant;
 use clap::Args;
 use serde_json::json;
 
-use subdyn::fit::recover::{RecoverParams, component_cage, prepare_volume, recover_shape};
+use subdyn::fit::recover::{RecoverParams, component_cage, prepare_volume_owned, recover_shape};
 use subdyn::forces::BoundaryModel;
 use subdyn::limit::tessellate;
 use subdyn::math::{Point3, Real};
@@ -24,6 +32,7 @@ use subdyn::volume::Volume;
 
 use super::bench::set_threads;
 use super::common::{print_stdout, thousands};
+use super::memory::{StagePeaks, current_rss, peak_rss, stage_peak};
 use super::progress::Progress;
 
 /// Arguments of `subdyn bench recover`.
@@ -44,14 +53,6 @@ pub struct BenchRecoverArgs {
     /// No progress display.
     #[arg(short, long)]
     pub quiet: bool,
-}
-
-/// Peak resident memory of this process in bytes (Linux `VmHWM`), if known.
-fn peak_rss() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
 }
 
 /// Runs the benchmark; the last stdout line is one JSON object.
@@ -95,7 +96,7 @@ pub fn bench_recover(args: &BenchRecoverArgs) -> anyhow::Result<()> {
     }
     let volume = Volume::new([n; 3], data, [1.0; 3], Point3::origin())?;
     let volume_bytes = (n * n * n * 4) as u64;
-    let rss_before = peak_rss();
+    let synth_peak = peak_rss();
     let params = RecoverParams {
         boundary: if args.edges {
             BoundaryModel::Edge { min_strength: 0.1 }
@@ -104,26 +105,49 @@ pub fn bench_recover(args: &BenchRecoverArgs) -> anyhow::Result<()> {
         },
         ..Default::default()
     };
+    // Every stage's peak resident memory is measured on its own (reset of
+    // the high-water mark before it). The input is smoothed in its own
+    // memory and given up, as in `subdyn recover`.
     progress.stage("smoothing and force field");
-    let prepared = prepare_volume(&volume, &params)?;
+    let (prepared, prepare_peak) = stage_peak(|| prepare_volume_owned(volume, &params));
+    let prepared = prepared?;
     progress.stage("initial model");
     let t = Instant::now();
-    let cage = component_cage(&prepared.smoothed, prepared.inside_level, true, None, 24)?;
+    let (cage, init_peak) =
+        stage_peak(|| component_cage(&prepared.smoothed, prepared.inside_level, true, None, 24));
+    let cage = cage?;
     let init_s = t.elapsed().as_secs_f64();
     let mut on_step = |level: usize, step: usize, _e: f64| {
         progress.stage(format!("level {level}, step {step}"));
     };
-    let result = recover_shape(&prepared, &cage.mesh, &[], &params, &mut on_step)?;
+    let (result, evolution_peak) =
+        stage_peak(|| recover_shape(&prepared, &cage.mesh, &[], &params, &mut on_step));
+    let result = result?;
     drop(progress);
     let evolution_s: f64 = result.report.levels.iter().map(|l| l.seconds).sum();
-    let refiner = Refiner::new(&result.control, &RefineOptions::default())?;
-    let (surf, _) = tessellate(&refiner, &result.control.positions, 4)?;
+    let after_rss = current_rss();
+    // The accuracy check below is the bench's own measurement, not part of
+    // the recovery; its memory is reported separately.
+    let (surf, check_peak) = stage_peak(|| -> anyhow::Result<_> {
+        let refiner = Refiner::new(&result.control, &RefineOptions::default())?;
+        Ok(tessellate(&refiner, &result.control.positions, 4)?.0)
+    });
+    let surf = surf?;
     let d: Vec<Real> = surf.positions.iter().map(|p| sdf(p).abs()).collect();
     let mean = d.iter().sum::<Real>() / d.len() as Real;
     let max = d.iter().cloned().fold(0.0, Real::max);
     let field_s = prepared.smoothing_seconds + prepared.potential_seconds;
     let total_s = field_s + init_s + evolution_s;
-    let peak = peak_rss();
+    let memory = StagePeaks {
+        volume_bytes,
+        stages: vec![
+            ("synthesis", synth_peak),
+            ("smoothing and force field", prepare_peak),
+            ("initial cage", init_peak),
+            ("evolution", evolution_peak),
+        ],
+    };
+    let peak = memory.max();
     let mut text = String::new();
     writeln!(
         text,
@@ -156,16 +180,17 @@ pub fn bench_recover(args: &BenchRecoverArgs) -> anyhow::Result<()> {
         text,
         "total {total_s:.2} s (goal < 20 s); distance to the true torus: mean {mean:.3}, max {max:.3} voxels (goal: 1 voxel)"
     )?;
-    let ratio = peak.map(|p| p as f64 / volume_bytes as f64);
-    if let Some(r) = ratio {
-        writeln!(
-            text,
-            "peak memory {:.0} MB = {r:.2} × the volume's f32 size ({:.0} MB; goal < 4 ×); after synthesis {:.0} MB",
-            peak.unwrap_or(0) as f64 / 1e6,
-            volume_bytes as f64 / 1e6,
-            rss_before.unwrap_or(0) as f64 / 1e6
-        )?;
-    }
+    text.push_str(&memory.line());
+    let mb = |b: Option<u64>| b.map_or("?".to_string(), |b| format!("{:.0}", b as f64 / 1e6));
+    let ratio = peak.map(|p| memory.ratio(p));
+    writeln!(
+        text,
+        "recovery peak {} MB = {} × the volume's f32 size (goal < 4 ×); accuracy check (not part of the recovery) {} MB; resident after the evolution {} MB",
+        mb(peak),
+        ratio.map_or("?".to_string(), |r| format!("{r:.2}")),
+        mb(check_peak),
+        mb(after_rss)
+    )?;
     let record = json!({
         "bench": "recover",
         "size": n,
@@ -182,6 +207,8 @@ pub fn bench_recover(args: &BenchRecoverArgs) -> anyhow::Result<()> {
         "mean_distance_voxels": mean,
         "max_distance_voxels": max,
         "peak_memory_ratio": ratio,
+        "peak_memory": memory.json(),
+        "accuracy_check_peak_bytes": check_peak,
     });
     writeln!(text, "{record}")?;
     print_stdout(&text)

@@ -18,6 +18,7 @@ mod info;
 mod info_volume;
 mod lattice;
 mod limit;
+mod memory;
 mod mesh_stats;
 mod options;
 mod progress;

@@ -9,11 +9,11 @@ use clap::Args;
 use serde_json::json;
 
 use subdyn::fit::recover::{
-    PreparedVolume, RecoverParams, RecoverReport, component_cage, prepare_volume, recover_shape,
-    seed_cage,
+    PreparedVolume, RecoverParams, RecoverReport, component_cage, prepare_volume_owned,
+    recover_shape, seed_cage,
 };
 use subdyn::forces::BoundaryModel;
-use subdyn::io::{VolumeReadOptions, read_points, read_volume, write_mesh};
+use subdyn::io::{VolumeFile, VolumeReadOptions, read_points, read_volume, write_mesh};
 use subdyn::limit::tessellate;
 use subdyn::math::{Point3, Real};
 use subdyn::mesh::PolyMesh;
@@ -22,6 +22,7 @@ use subdyn::subdivision::{RefineOptions, Refiner};
 use super::common::{
     about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, write_report,
 };
+use super::memory::{StagePeaks, peak_rss, stage_peak};
 use super::options::read_polygon_mesh;
 use super::progress::Progress;
 
@@ -161,30 +162,48 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     let progress = Progress::new(args.quiet);
     progress.stage(format!("reading {}", args.input.display()));
     let t = Instant::now();
-    let file = read_volume(
-        &args.input,
-        &VolumeReadOptions {
-            spacing: args.spacing,
-            origin: args.origin,
-        },
-    )
-    .map_err(|e| about_file(e, &args.input))?;
+    let read_options = VolumeReadOptions {
+        spacing: args.spacing,
+        origin: args.origin,
+    };
+    let VolumeFile {
+        volume: input,
+        source,
+        notes,
+        ..
+    } = read_volume(&args.input, &read_options).map_err(|e| about_file(e, &args.input))?;
     let read_s = seconds(t);
-    let volume = &file.volume;
+    let read_peak = peak_rss();
+    // The input is smoothed in its own memory and given up; the smoothed
+    // volume has the same grid, and --slices-png reads the input again.
+    let volume_bytes = 4 * input.data().len() as u64;
     progress.stage("smoothing and edge detection");
-    let prepared = prepare_volume(volume, &params).map_err(|e| {
+    let (prepared, prepare_peak) = stage_peak(|| prepare_volume_owned(input, &params));
+    let prepared = prepared.map_err(|e| {
         anyhow::Error::new(e).context(format!("preparing {}", args.input.display()))
     })?;
     progress.stage("building the initial model");
     let t = Instant::now();
-    let (init, init_json) = initial_model(args, &prepared)?;
+    let (init, init_peak) = stage_peak(|| initial_model(args, &prepared));
+    let (init, init_json) = init?;
     let init_s = seconds(t);
     let mut on_step = |level: usize, step: usize, energy: f64| {
         progress.stage(format!("level {level}, step {step}: energy {energy:.4e}"));
     };
-    let result = recover_shape(&prepared, &init, &points, &params, &mut on_step).map_err(|e| {
+    let (result, evolution_peak) =
+        stage_peak(|| recover_shape(&prepared, &init, &points, &params, &mut on_step));
+    let result = result.map_err(|e| {
         anyhow::Error::new(e).context(format!("recovering from {}", args.input.display()))
     })?;
+    let memory = StagePeaks {
+        volume_bytes,
+        stages: vec![
+            ("read", read_peak),
+            ("smoothing", prepare_peak),
+            ("initial model", init_peak),
+            ("evolution", evolution_peak),
+        ],
+    };
     progress.stage(format!("writing {}", args.output.display()));
     write_mesh(&args.output, &result.control, None).map_err(|e| about_file(e, &args.output))?;
     let surface = |mesh: &PolyMesh| -> anyhow::Result<(PolyMesh, Vec<subdyn::math::Vector3>)> {
@@ -199,18 +218,22 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     if let Some(dir) = &args.slices_png {
         progress.stage("drawing slices");
         let (init_surf, _) = surface(&init)?;
-        slice_files = write_slices(dir, volume, &surf, &init_surf)?;
+        let image = read_volume(&args.input, &read_options)
+            .map_err(|e| about_file(e, &args.input))?
+            .volume;
+        slice_files = write_slices(dir, &image, &surf, &init_surf)?;
     }
     drop(progress);
     if let Some(path) = &args.report {
+        let grid = &prepared.smoothed;
         let value = json!({
             "command": "recover",
             "input": args.input.display().to_string(),
-            "format": file.source,
-            "notes": file.notes,
-            "dims": volume.dims(),
-            "spacing": volume.spacing(),
-            "origin": [volume.origin().x, volume.origin().y, volume.origin().z],
+            "format": source,
+            "notes": notes,
+            "dims": grid.dims(),
+            "spacing": grid.spacing(),
+            "origin": [grid.origin().x, grid.origin().y, grid.origin().z],
             "output": args.output.display().to_string(),
             "limit_out": args.limit_out.as_ref().map(|p| p.display().to_string()),
             "init": init_json,
@@ -222,12 +245,14 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
                 "evolution": result.report.levels.iter().map(|l| l.seconds).sum::<f64>(),
             },
             "recover": serde_json::to_value(&result.report)?,
+            "peak_memory": memory.json(),
             "slices": slice_files,
             "total_s": seconds(start),
         });
         write_report(path, &value)?;
     }
-    let mut text = summary(args, &file.notes, read_s, init_s, &result.report);
+    let mut text = summary(args, &notes, read_s, init_s, &result.report);
+    text.push_str(&memory.line());
     if !slice_files.is_empty() {
         text.push_str(&format!(
             "slices: {} PNGs in {}\n",

@@ -135,11 +135,15 @@ fn patch_element(
     let Some(grid) = table.grid_rows(f) else {
         // Irregular: exact stencils at the Gauss points of the whole patch.
         let mut cols: Vec<u32> = Vec::new();
-        let samples: Vec<(SampleStencil, Real)> = gl
+        let (sts, ws): (Vec<[Real; 2]>, Vec<Real>) = gl
             .iter()
             .flat_map(|&(a, wa)| gl.iter().map(move |&(b, wb)| ([a, b], wa * wb)))
-            .map(|(st, w)| {
-                let mut s = table.stencil(f, st);
+            .unzip();
+        let samples: Vec<(SampleStencil, Real)> = table
+            .stencils(f, &sts)
+            .into_iter()
+            .zip(ws)
+            .map(|(mut s, w)| {
                 rows_to_base(&mut s.weights, inv);
                 cols.extend_from_slice(&s.cols);
                 (s, w * det)

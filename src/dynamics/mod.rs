@@ -7,8 +7,10 @@ mod elements;
 mod matrices;
 mod pcg;
 mod quadrature;
+mod sample_rows;
 
 pub use elements::{parameter_area, patch_damping_matrix, patch_stiffness_matrix};
 pub use matrices::{MaterialParams, damping_matrix, mass_matrix, stiffness_matrix};
 pub use pcg::{PcgParams, PcgReport, pcg};
 pub use quadrature::{Quadrature, gauss_legendre, patch_samples, quadrature};
+pub use sample_rows::{SampleRows, patch_sample_rows};

@@ -101,17 +101,21 @@ fn quadrature_on(table: &PatchTable, order: usize, per_piece: bool) -> Result<Qu
             for (jac, off) in cells {
                 let inv = invert(jac);
                 let det_inv = (inv[0][0] * inv[1][1] - inv[0][1] * inv[1][0]).abs();
-                for &(a, wa) in &gl {
-                    for &(b, wb) in &gl {
+                let (sts, ws): (Vec<[Real; 2]>, Vec<Real>) = gl
+                    .iter()
+                    .flat_map(|&(a, wa)| gl.iter().map(move |&(b, wb)| (a, b, wa * wb)))
+                    .map(|(a, b, w)| {
                         let d = [a - off[0], b - off[1]];
                         let st = [
                             inv[0][0] * d[0] + inv[0][1] * d[1],
                             inv[1][0] * d[0] + inv[1][1] * d[1],
                         ];
-                        let mut s = table.stencil(f, st);
-                        rows_to_base(&mut s.weights, inv_axes);
-                        out.push((s, wa * wb * det_inv * det_axes));
-                    }
+                        (st, w * det_inv * det_axes)
+                    })
+                    .unzip();
+                for (mut s, w) in table.stencils(f, &sts).into_iter().zip(ws) {
+                    rows_to_base(&mut s.weights, inv_axes);
+                    out.push((s, w));
                 }
             }
             out

@@ -270,6 +270,35 @@ impl PatchTable {
             return builders_to_stencil(&b);
         }
         let tree = patch.tree.get_or_init(|| self.tree(f));
+        self.tree_stencil(tree, f, st)
+    }
+
+    /// [`stencil`](Self::stencil) at several points of patch `f`. An
+    /// irregular patch's quadtree is used if [`stencil`](Self::stencil) or an
+    /// evaluation has cached it, and otherwise built for this call alone and
+    /// dropped: the sample sets of the dynamics ([`crate::dynamics`]) visit
+    /// every patch once, and caching all the quadtrees would hold tens of
+    /// kilobytes per irregular patch for the rest of the table's life.
+    pub fn stencils(&self, f: usize, sts: &[[Real; 2]]) -> Vec<SampleStencil> {
+        let patch = &self.patches[f];
+        if patch.regular {
+            return sts.iter().map(|&st| self.stencil(f, st)).collect();
+        }
+        let local;
+        let tree = match patch.tree.get() {
+            Some(tree) => tree,
+            None => {
+                local = self.tree(f);
+                &local
+            }
+        };
+        sts.iter()
+            .map(|&st| self.tree_stencil(tree, f, st))
+            .collect()
+    }
+
+    /// The stencil at `(s, t)` of irregular patch `f` from its quadtree.
+    fn tree_stencil(&self, tree: &Tree, f: usize, st: [Real; 2]) -> SampleStencil {
         let nc = tree.cols.len();
         for leaf in &tree.leaves {
             let x = [

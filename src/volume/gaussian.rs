@@ -17,8 +17,29 @@ const TRUNCATE: Real = 3.0;
 /// `σ_a = σ / s_a` voxels, `s_a` the axis's spacing, sampled at integer
 /// offsets up to `⌈3 σ_a⌉` and normalised to sum 1; borders repeat the edge
 /// sample. `sigma = 0` returns a copy. The three 1D passes run in parallel
-/// over z slabs.
+/// and in place on the copy: the input and the result are the only
+/// volumes alive.
 pub fn gaussian_smoothed(volume: &Volume, sigma: Real) -> Result<Volume> {
+    let kernels = kernels_of(volume, sigma)?;
+    let mut data = volume.data().to_vec();
+    smooth_in_place(&mut data, volume.dims(), &kernels);
+    volume.with_data(data)
+}
+
+/// [`gaussian_smoothed`] in the input's own samples: the volume is given
+/// up and no second one is ever allocated (for a caller that needs only
+/// the smoothed image).
+pub fn gaussian_smoothed_owned(volume: Volume, sigma: Real) -> Result<Volume> {
+    let kernels = kernels_of(&volume, sigma)?;
+    let (dims, linear, origin) = (volume.dims(), *volume.linear(), volume.origin());
+    let mut data = volume.into_data();
+    smooth_in_place(&mut data, dims, &kernels);
+    Volume::with_affine(dims, data, linear, origin)
+}
+
+/// The per-axis kernels of `sigma` on `volume`'s grid; errors for a
+/// negative or non-finite σ, or one far wider than the volume.
+fn kernels_of(volume: &Volume, sigma: Real) -> Result<Vec<Vec<f32>>> {
     if !(sigma.is_finite() && sigma >= 0.0) {
         return Err(Error::Input(format!(
             "smoothing sigma {sigma} must be a finite length ≥ 0"
@@ -33,29 +54,38 @@ pub fn gaussian_smoothed(volume: &Volume, sigma: Real) -> Result<Volume> {
             kernels[a].len() / 2
         )));
     }
-    let mut data = volume.data().to_vec();
-    let mut tmp = vec![0f32; data.len()];
+    Ok(kernels)
+}
+
+/// The three 1D passes on `data` in place. Each pass copies what one task
+/// reads (an x line, a z slab, or the x lines of one y across all z) into a
+/// per-thread buffer and writes the result back, so no second volume is
+/// ever allocated. The sums are the same, in the same order, as an
+/// out-of-place pass would form them.
+fn smooth_in_place(data: &mut [f32], dims: [usize; 3], kernels: &[Vec<f32>]) {
     let [nx, ny, nz] = dims;
     let slab = nx * ny;
-    // x: rows within each slab.
+    // x: along each line.
     if kernels[0].len() > 1 {
         let k = &kernels[0];
-        tmp.par_chunks_mut(nx)
-            .zip(data.par_chunks(nx))
-            .for_each(|(out, row)| {
-                convolve_line(row, out, k);
+        data.par_chunks_mut(nx)
+            .for_each_init(Vec::new, |buf: &mut Vec<f32>, row| {
+                buf.clear();
+                buf.extend_from_slice(row);
+                convolve_line(buf, row, k);
             });
-        std::mem::swap(&mut data, &mut tmp);
     }
-    // y: whole rows combined within each slab.
+    // y: whole lines combined within each slab.
     if kernels[1].len() > 1 {
         let k = &kernels[1];
-        tmp.par_chunks_mut(slab)
-            .zip(data.par_chunks(slab))
-            .for_each(|(out, src)| {
+        data.par_chunks_mut(slab)
+            .for_each_init(Vec::new, |buf: &mut Vec<f32>, s| {
+                buf.clear();
+                buf.extend_from_slice(s);
+                let src: &[f32] = buf;
                 for j in 0..ny {
                     accumulate_rows(
-                        &mut out[j * nx..(j + 1) * nx],
+                        &mut s[j * nx..(j + 1) * nx],
                         |t| {
                             let jj = (j as isize + t).clamp(0, ny as isize - 1) as usize;
                             &src[jj * nx..(jj + 1) * nx]
@@ -64,25 +94,35 @@ pub fn gaussian_smoothed(volume: &Volume, sigma: Real) -> Result<Volume> {
                     );
                 }
             });
-        std::mem::swap(&mut data, &mut tmp);
     }
-    // z: whole slabs combined.
+    // z: for every y, the x lines of all slabs combined.
     if kernels[2].len() > 1 {
         let k = &kernels[2];
-        let src = &data;
-        tmp.par_chunks_mut(slab).enumerate().for_each(|(z, out)| {
-            accumulate_rows(
-                out,
-                |t| {
-                    let zz = (z as isize + t).clamp(0, nz as isize - 1) as usize;
-                    &src[zz * slab..(zz + 1) * slab]
-                },
-                k,
-            );
-        });
-        std::mem::swap(&mut data, &mut tmp);
+        let mut by_y: Vec<Vec<&mut [f32]>> = (0..ny).map(|_| Vec::with_capacity(nz)).collect();
+        for s in data.chunks_mut(slab) {
+            for (lines, line) in by_y.iter_mut().zip(s.chunks_mut(nx)) {
+                lines.push(line);
+            }
+        }
+        by_y.par_iter_mut()
+            .for_each_init(Vec::new, |buf: &mut Vec<f32>, lines| {
+                buf.clear();
+                for line in lines.iter() {
+                    buf.extend_from_slice(line);
+                }
+                let src: &[f32] = buf;
+                for (z, line) in lines.iter_mut().enumerate() {
+                    accumulate_rows(
+                        line,
+                        |t| {
+                            let zz = (z as isize + t).clamp(0, nz as isize - 1) as usize;
+                            &src[zz * nx..(zz + 1) * nx]
+                        },
+                        k,
+                    );
+                }
+            });
     }
-    volume.with_data(data)
 }
 
 /// Normalised Gaussian taps at offsets `−r ..= r`, `r = ⌈3σ⌉`; `[1]` for σ < 0.1 voxel.

@@ -99,6 +99,11 @@ impl Volume {
         &self.data
     }
 
+    /// The samples, giving up the volume (x fastest).
+    pub fn into_data(self) -> Vec<f32> {
+        self.data
+    }
+
     /// A volume on the same grid with other samples.
     pub fn with_data(&self, data: Vec<f32>) -> Result<Self> {
         Self::with_affine(self.dims, data, self.linear, self.origin)

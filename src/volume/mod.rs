@@ -7,6 +7,6 @@ mod grid;
 mod threshold;
 
 pub use edges::edge_potential;
-pub use gaussian::gaussian_smoothed;
+pub use gaussian::{gaussian_smoothed, gaussian_smoothed_owned};
 pub use grid::Volume;
 pub use threshold::otsu_threshold;

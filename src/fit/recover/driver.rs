@@ -1,10 +1,10 @@
 //! The multilevel volume-recovery driver (Qin, Mandal, Vemuri 1998, §4.2
 //! and §6, the cerebellum and caudate experiments).
 //!
-//! [`prepare_volume`] smooths the volume (`G_σ * I`), computes the edge
-//! potential when edges are wanted, and fixes the intensity that separates
-//! inside from outside (the iso-value, or Otsu's threshold). [`recover_shape`]
-//! then evolves the control points with the first-order dynamics of the
+//! [`prepare_volume`](super::prepare_volume) smooths the volume (`G_σ * I`),
+//! computes the edge potential when edges are wanted, and fixes the
+//! intensity that separates inside from outside (the iso-value, or Otsu's
+//! threshold). [`recover_shape`] then evolves the control points with the first-order dynamics of the
 //! point-cloud fit, `(γ/Δt · D + K + Σ k JᵀJ) p⁺ = γ/Δt · D p + Σ k Jᵀ y`, the
 //! targets `y = x + t n` being the image boundary found along the normal of
 //! every quadrature point (see [`crate::forces::ImageField`]), with stiffness
@@ -16,83 +16,18 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use super::{RecoverLevel, RecoverParams, RecoverReport};
+use super::{PreparedVolume, RecoverLevel, RecoverParams, RecoverReport};
 use crate::dynamics::{
-    MaterialParams, PcgParams, patch_damping_matrix, patch_samples, patch_stiffness_matrix, pcg,
+    MaterialParams, PcgParams, patch_damping_matrix, patch_sample_rows, patch_stiffness_matrix, pcg,
 };
 use crate::error::{Error, Result};
 use crate::fit::ErrorStats;
-use crate::forces::{
-    BoundaryModel, ImageField, Offset, inflation_force, row_springs, spring_system,
-};
+use crate::forces::{ImageField, Offset, inflation_force, row_springs, spring_system};
 use crate::limit::{ClosestPointEngine, ClosestPointParams, PatchTable};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::PolyMesh;
 use crate::stencil::StencilTable;
 use crate::subdivision::{RefineOptions, Refiner};
-use crate::volume::{Volume, edge_potential, gaussian_smoothed, otsu_threshold};
-
-/// A volume ready for recovery: smoothed, with its edge potential.
-#[derive(Clone, Debug)]
-pub struct PreparedVolume {
-    /// `G_σ * I`.
-    pub smoothed: Volume,
-    /// The edge potential (for [`BoundaryModel::Edge`]).
-    pub potential: Option<Volume>,
-    /// Intensity separating inside from outside: the iso-value, or Otsu's
-    /// threshold of the smoothed volume.
-    pub inside_level: Real,
-    /// σ used, world units.
-    pub sigma: Real,
-    /// Seconds spent smoothing.
-    pub smoothing_seconds: Real,
-    /// Seconds spent on the potential.
-    pub potential_seconds: Real,
-}
-
-/// The precompute step: smoothing, edge potential and inside level.
-/// Errors for a constant volume.
-pub fn prepare_volume(volume: &Volume, params: &RecoverParams) -> Result<PreparedVolume> {
-    params.check()?;
-    let (lo, hi) = volume.range();
-    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
-        return Err(Error::Input(format!(
-            "the volume is constant ({lo}): there is no boundary to recover"
-        )));
-    }
-    let sigma = params.sigma.unwrap_or(
-        match params.boundary {
-            BoundaryModel::Iso { .. } => 0.5,
-            BoundaryModel::Edge { .. } => 1.0,
-        } * volume.voxel_size(),
-    );
-    let t = Instant::now();
-    let smoothed = gaussian_smoothed(volume, sigma)?;
-    let smoothing_seconds = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let (potential, inside_level) = match params.boundary {
-        BoundaryModel::Iso { value } => {
-            if !(value > lo as Real && value < hi as Real) {
-                return Err(Error::Input(format!(
-                    "iso-value {value} lies outside the volume's range [{lo}, {hi}]"
-                )));
-            }
-            (None, value)
-        }
-        BoundaryModel::Edge { .. } => (
-            Some(edge_potential(&smoothed)?),
-            otsu_threshold(&smoothed)? as Real,
-        ),
-    };
-    Ok(PreparedVolume {
-        smoothed,
-        potential,
-        inside_level,
-        sigma,
-        smoothing_seconds,
-        potential_seconds: t.elapsed().as_secs_f64(),
-    })
-}
 
 /// A recovered shape and what it took.
 #[derive(Clone, Debug)]
@@ -145,16 +80,16 @@ pub fn recover_shape(
             ));
         }
         let qtable = PatchTable::new(&refiner, &mesh.positions, 1)?;
-        let s = qtable.to_level();
         // One set of Gauss points per level-1 patch carries both the image
         // springs and the thin plate: exact on regular patches, and near
         // irregular vertices a fixed number of exact samples instead of
         // `quadrature`'s quadtree leaves, which cost ten times more to
         // assemble for a vanishing share of the area.
-        let q = patch_samples(&qtable, params.quadrature_order)?;
-        let j = q.rows.p.compose(s)?;
-        let ju = q.rows.du.compose(s)?;
-        let jv = q.rows.dv.compose(s)?;
+        // First derivatives only, composed to the control points as they are
+        // evaluated: the second derivatives enter K alone, assembled patch
+        // by patch below.
+        let q = patch_sample_rows(&qtable, params.quadrature_order)?;
+        let (j, ju, jv) = (&q.j, &q.ju, &q.jv);
         let area: Real = q.weights.iter().sum();
         let material = MaterialParams::thin_plate(params.tension, params.bending, area);
         let k = patch_stiffness_matrix(&qtable, params.quadrature_order, &material)?;
@@ -167,6 +102,7 @@ pub fn recover_shape(
         let delta = 0.01 * diag.iter().sum::<Real>() / diag.len().max(1) as Real;
         let d = d.linear_combination(1.0, &StencilTable::identity(diag.len()), delta)?;
         let kd = k.linear_combination(1.0, &d, 1.0)?;
+        drop(qtable);
         let sample_step = 0.25 * voxel;
         let search_of = |p: &[Point3]| {
             params
@@ -230,7 +166,7 @@ pub fn recover_shape(
             }
             let targets: Vec<Point3> = found.iter().map(|f| f.0).collect();
             let kw: Vec<Real> = found.iter().map(|f| f.1 / total).collect();
-            let mut springs = row_springs(&j, &xs, &targets, &kw)?;
+            let mut springs = row_springs(j, &xs, &targets, &kw)?;
             if let Some(engine) = &mut engine {
                 engine.set_positions(&p)?;
                 let closest = engine.closest_points(points)?;
@@ -284,8 +220,7 @@ pub fn recover_shape(
                 .map(|(a, b)| Point3::from(a.coords + b.coords))
                 .collect();
             if params.inflation != 0.0 {
-                let level_p = s.apply(&p)?;
-                let f = inflation_force(&q, s, &level_p, params.inflation * voxel / total)?;
+                let f = inflation_force(&q, &p, params.inflation * voxel / total)?;
                 for (r, f) in rhs.iter_mut().zip(&f) {
                     r.coords += f.coords;
                 }

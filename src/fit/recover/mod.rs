@@ -5,9 +5,11 @@
 mod driver;
 mod init;
 mod params;
+mod prepare;
 mod report;
 
-pub use driver::{PreparedVolume, RecoverResult, prepare_volume, recover_shape};
+pub use driver::{RecoverResult, recover_shape};
 pub use init::{ComponentCage, component_cage, seed_cage};
 pub use params::RecoverParams;
+pub use prepare::{PreparedVolume, prepare_volume, prepare_volume_owned};
 pub use report::{RecoverLevel, RecoverReport};
