@@ -137,6 +137,11 @@ fn scatter_sum(
             (acc, e)
         })
         .collect();
+    summed_partials(results, out)
+}
+
+/// Adds the per-thread accumulators into `out` and returns their energies' sum.
+fn summed_partials(results: Vec<(Vec<Vector3>, Real)>, out: &mut [Vector3]) -> Real {
     let mut energy = 0.0;
     for (acc, e) in results {
         energy += e;
@@ -374,14 +379,7 @@ impl SpringNetwork {
                 (acc, energy)
             })
             .collect();
-        let mut energy = 0.0;
-        for (acc, e) in results {
-            energy += e;
-            for (o, a) in out.iter_mut().zip(acc) {
-                *o += a;
-            }
-        }
-        energy
+        summed_partials(results, out)
     }
 
     /// Adds `K w` into `out` with the Hessians of [`hessians_into`](Self::hessians_into).
