@@ -6,7 +6,8 @@ mod common;
 use common::{default_refiner, reference_mesh};
 use subdyn::dynamics::{
     MaterialParams, PcgParams, damping_matrix, gauss_legendre, mass_matrix, patch_damping_matrix,
-    patch_sample_rows, patch_samples, patch_stiffness_matrix, pcg, quadrature, stiffness_matrix,
+    patch_sample_rows, patch_samples, patch_stiffness_and_damping, patch_stiffness_matrix, pcg,
+    quadrature, stiffness_matrix,
 };
 use subdyn::limit::{LimitEvaluator, PatchTable, tessellate};
 use subdyn::math::{Point3, Real};
@@ -458,4 +459,126 @@ fn batched_stencils_equal_single_stencils() {
             assert_eq!(c.weights, b.weights, "patch {f}");
         }
     }
+}
+
+/// `K` and `D` assembled in one pass equal the matrices assembled apart.
+#[test]
+fn stiffness_and_damping_in_one_pass_equal_the_separate_matrices() {
+    let params = MaterialParams::default();
+    let mesh = subdyn::examples::cube();
+    let table = PatchTable::new(&default_refiner(&mesh), &mesh.positions, 1).unwrap();
+    let [k, d] = patch_stiffness_and_damping(&table, 4, &params, 0.3).unwrap();
+    for (together, apart) in [
+        (k, patch_stiffness_matrix(&table, 4, &params).unwrap()),
+        (d, patch_damping_matrix(&table, 4, 0.3).unwrap()),
+    ] {
+        let (worst, scale) = table_difference(&together, &apart);
+        assert!(
+            scale > 0.0 && worst <= 1e-14 * scale,
+            "{worst:e} of {scale:e}"
+        );
+    }
+    assert!(patch_stiffness_and_damping(&table, 4, &params, -1.0).is_err());
+}
+
+/// Springs assembled into the patches' fixed pattern equal the sparse
+/// products `Σ k JᵀJ`, `Σ k Jᵀ d` of `spring_system` / `row_springs`, on
+/// meshes with irregular vertices, boundaries and n-gons; `K` carried into
+/// the pattern is unchanged; a matrix outside the pattern is refused.
+#[test]
+fn patch_assembly_equals_the_sparse_spring_products() {
+    use subdyn::forces::{PatchAssembly, row_springs, spring_system};
+    use subdyn::limit::{ClosestPointEngine, ClosestPointParams};
+    let mut seed = 7u64;
+    for mesh in [
+        subdyn::examples::cube(),
+        reference_mesh("fan5_open"),
+        common::mixed_mesh(),
+    ] {
+        let r = default_refiner(&mesh);
+        let engine = ClosestPointEngine::new(
+            &r,
+            &mesh.positions,
+            &ClosestPointParams {
+                level: 1,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let table = engine.table();
+        let assembly = PatchAssembly::new(table).unwrap();
+        let scale = common::diag(&mesh.positions);
+        let points: Vec<Point3> = (0..300)
+            .map(|i| {
+                let v = mesh.positions[i % mesh.positions.len()];
+                v + scale
+                    * 0.3
+                    * nalgebra::Vector3::new(lcg(&mut seed), lcg(&mut seed), lcg(&mut seed))
+            })
+            .collect();
+        let closest = engine.closest_points(&points).unwrap();
+        let k: Vec<Real> = (0..points.len())
+            .map(|i| if i % 7 == 0 { 0.0 } else { lcg(&mut seed) })
+            .collect();
+        let reference = spring_system(&engine, &points, &closest, &k).unwrap();
+        let fast = assembly.data_springs(table, &points, &closest, &k).unwrap();
+        let (worst, m) = table_difference(&reference.matrix, &fast.matrix);
+        assert!(m > 0.0 && worst <= 1e-12 * m, "matrix {worst:e} of {m:e}");
+        for (a, b) in reference.rhs.iter().zip(&fast.rhs) {
+            assert!((a - b).norm() <= 1e-12 * scale, "rhs {a} vs {b}");
+        }
+        assert!((reference.energy - fast.energy).abs() <= 1e-12 * reference.energy);
+
+        // Rows already over the control points (as the surface samples are).
+        let s = table.to_level();
+        let at: Vec<(usize, [Real; 2])> = (0..200)
+            .map(|i| (i % table.num_patches(), [lcg(&mut seed), lcg(&mut seed)]))
+            .collect();
+        let mut rows = StencilTable::with_capacity(s.num_rows(), at.len(), 0);
+        for &(f, st) in &at {
+            let (c, w) = table.position_stencil(f, st);
+            rows.push_row(c.into_iter().zip(w));
+        }
+        let rows = rows.compose(s).unwrap();
+        let x = rows.apply(&mesh.positions).unwrap();
+        let d: Vec<Point3> = x
+            .iter()
+            .map(|p| p + nalgebra::Vector3::new(0.1, -0.2, 0.05))
+            .collect();
+        let kr: Vec<Real> = (0..at.len()).map(|_| lcg(&mut seed)).collect();
+        let reference = row_springs(&rows, &x, &d, &kr).unwrap();
+        let fast = assembly
+            .row_springs(&rows, |i| at[i].0, &x, &d, &kr)
+            .unwrap();
+        let (worst, m) = table_difference(&reference.matrix, &fast.matrix);
+        assert!(
+            m > 0.0 && worst <= 1e-12 * m,
+            "row matrix {worst:e} of {m:e}"
+        );
+        let stiffness = patch_stiffness_matrix(table, 4, &MaterialParams::default()).unwrap();
+        let carried = assembly.matrix(assembly.values_of(&stiffness).unwrap());
+        let (worst, m) = table_difference(&stiffness, &carried);
+        assert!(worst <= 1e-15 * m, "K in the pattern {worst:e} of {m:e}");
+    }
+    // On a 6 × 6 grid, the corners share no patch: a dense matrix is refused.
+    let grid = common::grid(6, 1);
+    let table = PatchTable::new(&default_refiner(&grid), &grid.positions, 1).unwrap();
+    let assembly = PatchAssembly::new(&table).unwrap();
+    let n = grid.positions.len();
+    let full = StencilTable::from_rows(n, &vec![(0..n as u32).map(|c| (c, 1.0)).collect(); n]);
+    assert!(assembly.values_of(&full).is_err());
+    assert!(assembly.num_entries() < n * n);
+    // A row of the first patch, claimed to be on the last, leaves its support.
+    let (c, w) = table.position_stencil(0, [0.5, 0.5]);
+    let mut row = StencilTable::with_capacity(table.to_level().num_rows(), 1, 0);
+    row.push_row(c.into_iter().zip(w));
+    let row = row.compose(table.to_level()).unwrap();
+    let x = row.apply(&grid.positions).unwrap();
+    let last = table.num_patches() - 1;
+    assert!(assembly.row_springs(&row, |_| 0, &x, &x, &[1.0]).is_ok());
+    assert!(
+        assembly
+            .row_springs(&row, |_| last, &x, &x, &[1.0])
+            .is_err()
+    );
 }

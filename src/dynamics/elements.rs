@@ -38,26 +38,57 @@ pub fn patch_stiffness_matrix(
     params: &MaterialParams,
 ) -> Result<StencilTable> {
     params.check()?;
-    let c = [
+    let [k] = assembled(table, order, [stiffness_weights(params)])?;
+    Ok(k)
+}
+
+/// `K` of [`patch_stiffness_matrix`] and `D` of [`patch_damping_matrix`]
+/// together, in one pass over the patches (their stencils are shared).
+pub fn patch_stiffness_and_damping(
+    table: &PatchTable,
+    order: usize,
+    params: &MaterialParams,
+    gamma: Real,
+) -> Result<[StencilTable; 2]> {
+    params.check()?;
+    damping_params(gamma).check()?;
+    assembled(
+        table,
+        order,
+        [stiffness_weights(params), damping_weights(gamma)],
+    )
+}
+
+/// The weights of `[J, J_u, J_v, J_uu, J_uv, J_vv]` in `K` (eq. 12).
+fn stiffness_weights(params: &MaterialParams) -> [Real; 6] {
+    [
         0.0,
         params.alpha11,
         params.alpha22,
         params.beta11,
         params.beta12,
         params.beta22,
-    ];
-    assembled(table, order, c)
+    ]
+}
+
+/// The weights of `[J, …]` in `D = ∫∫ γ JᵀJ`.
+fn damping_weights(gamma: Real) -> [Real; 6] {
+    [gamma, 0.0, 0.0, 0.0, 0.0, 0.0]
+}
+
+fn damping_params(gamma: Real) -> MaterialParams {
+    MaterialParams {
+        gamma,
+        ..Default::default()
+    }
 }
 
 /// `D = ∫∫ γ JᵀJ du dv` (or `M` with `γ = μ`) over the control points,
 /// patch by patch (module docs).
 pub fn patch_damping_matrix(table: &PatchTable, order: usize, gamma: Real) -> Result<StencilTable> {
-    MaterialParams {
-        gamma,
-        ..Default::default()
-    }
-    .check()?;
-    assembled(table, order, [gamma, 0.0, 0.0, 0.0, 0.0, 0.0])
+    damping_params(gamma).check()?;
+    let [d] = assembled(table, order, [damping_weights(gamma)])?;
+    Ok(d)
 }
 
 /// The area of the parameter domain (`∫∫ du dv` over the base faces, quad
@@ -68,36 +99,62 @@ pub fn parameter_area(table: &PatchTable) -> Real {
         .sum()
 }
 
-/// `Sᵀ (Σ_e K_e) S` for the weights `c` of `[J, J_u, J_v, J_uu, J_uv, J_vv]`.
-fn assembled(table: &PatchTable, order: usize, c: [Real; 6]) -> Result<StencilTable> {
+/// `Sᵀ (Σ_e K_e) S` for each set of weights `c` of `[J, J_u, J_v, J_uu,
+/// J_uv, J_vv]`.
+fn assembled<const N: usize>(
+    table: &PatchTable,
+    order: usize,
+    c: [[Real; 6]; N],
+) -> Result<[StencilTable; N]> {
     if order == 0 || order > 16 {
         return Err(Error::Input(format!(
             "quadrature order {order} must be between 1 and 16"
         )));
     }
     let gl = gauss_legendre(order);
-    let per_patch: Vec<(Vec<u32>, Vec<Real>)> = (0..table.num_patches())
+    let per_patch: Vec<(Vec<u32>, [Vec<Real>; N])> = (0..table.num_patches())
         .into_par_iter()
         .map_init(Vec::new, |frames, f| {
             patch_element(table, f, &gl, c, frames)
         })
         .collect();
-    let mut elements = Elements::new();
-    for (cols, matrix) in &per_patch {
-        elements.push(cols, matrix)?;
-    }
     let s = table.to_level();
-    StencilTable::from_elements(s.num_rows(), &elements)?.pulled_back(s)
+    let mut out = Vec::with_capacity(N);
+    for i in 0..N {
+        let mut elements = Elements::new();
+        for (cols, matrices) in &per_patch {
+            elements.push(cols, &matrices[i])?;
+        }
+        out.push(StencilTable::from_elements(s.num_rows(), &elements)?.pulled_back(s)?);
+    }
+    Ok(out
+        .try_into()
+        .unwrap_or_else(|_| unreachable!("one matrix per weight set")))
 }
+
+/// The regular patches' `16 × 16` grid matrices by frame (one per weight set).
+type FrameCache<const N: usize> = Vec<([[Real; 2]; 2], [Vec<Real>; N])>;
 
 /// Inverse of a 2 × 2 matrix and its |determinant|.
 fn inverse(m: [[Real; 2]; 2]) -> ([[Real; 2]; 2], Real) {
     (invert(m), (m[0][0] * m[1][1] - m[0][1] * m[1][0]).abs())
 }
 
-/// Adds `w · Σ_q c_q j_q j_qᵀ` to the dense `m × m` matrix `out`, the rows
-/// `j_q` given by `row(q)`.
-fn add_outer<'a>(
+/// Adds `w · Σ_q c_q j_q j_qᵀ` to each dense `m × m` matrix `out[i]` with
+/// its own `c[i]`, the rows `j_q` given by `row(q)`.
+fn add_outer<'a, const N: usize>(
+    out: &mut [Vec<Real>; N],
+    m: usize,
+    c: [[Real; 6]; N],
+    w: Real,
+    row: impl Fn(usize) -> &'a [Real],
+) {
+    for (out, c) in out.iter_mut().zip(c) {
+        add_outer_one(out, m, c, w, &row);
+    }
+}
+
+fn add_outer_one<'a>(
     out: &mut [Real],
     m: usize,
     c: [Real; 6],
@@ -123,13 +180,13 @@ fn add_outer<'a>(
 /// The element of patch `f` over the level-`L` vertices (columns and
 /// row-major matrix). `frames` caches
 /// the grid matrices of the frames seen so far (per thread).
-fn patch_element(
+fn patch_element<const N: usize>(
     table: &PatchTable,
     f: usize,
     gl: &[(Real, Real)],
-    c: [Real; 6],
-    frames: &mut Vec<([[Real; 2]; 2], Vec<Real>)>,
-) -> (Vec<u32>, Vec<Real>) {
+    c: [[Real; 6]; N],
+    frames: &mut FrameCache<N>,
+) -> (Vec<u32>, [Vec<Real>; N]) {
     let (_, axes) = table.patch_frame(f);
     let (inv, det) = inverse(axes);
     let Some(grid) = table.grid_rows(f) else {
@@ -152,7 +209,7 @@ fn patch_element(
         cols.sort_unstable();
         cols.dedup();
         let m = cols.len();
-        let mut matrix = vec![0.0; m * m];
+        let mut matrix = [(); N].map(|_| vec![0.0; m * m]);
         let mut dense = [(); 6].map(|_| vec![0.0; m]);
         for (s, w) in &samples {
             for (q, d) in dense.iter_mut().enumerate() {
@@ -170,7 +227,7 @@ fn patch_element(
     let e = match frames.iter().position(|(a, _)| *a == axes) {
         Some(i) => &frames[i].1,
         None => {
-            let mut e = vec![0.0; 256];
+            let mut e = [(); N].map(|_| vec![0.0; 256]);
             for &(a, wa) in gl {
                 for &(b, wb) in gl {
                     let mut rows = patch_weights(a, b);
@@ -192,6 +249,11 @@ fn patch_element(
             g[k * m + cols.binary_search(&col).unwrap_or(0)] += x;
         }
     }
+    (cols, std::array::from_fn(|i| carried(&e[i], &g, m)))
+}
+
+/// `Gᵀ E G` for the `16 × 16` grid matrix `E` and the `16 × m` grid rows `G`.
+fn carried(e: &[Real], g: &[Real], m: usize) -> Vec<Real> {
     // E G (16 × m), then Gᵀ (E G).
     let mut eg = vec![0.0; 16 * m];
     for a in 0..16 {
@@ -221,5 +283,5 @@ fn patch_element(
             }
         }
     }
-    (cols, matrix)
+    matrix
 }

@@ -9,7 +9,9 @@ mod pcg;
 mod quadrature;
 mod sample_rows;
 
-pub use elements::{parameter_area, patch_damping_matrix, patch_stiffness_matrix};
+pub use elements::{
+    parameter_area, patch_damping_matrix, patch_stiffness_and_damping, patch_stiffness_matrix,
+};
 pub use matrices::{MaterialParams, damping_matrix, mass_matrix, stiffness_matrix};
 pub use pcg::{PcgParams, PcgReport, pcg};
 pub use quadrature::{Quadrature, gauss_legendre, patch_samples, quadrature};

@@ -27,12 +27,13 @@
 use std::time::Instant;
 
 use crate::dynamics::{
-    MaterialParams, PcgParams, parameter_area, patch_damping_matrix, patch_stiffness_matrix, pcg,
+    MaterialParams, PcgParams, parameter_area, patch_damping_matrix, patch_stiffness_and_damping,
+    pcg,
 };
 use crate::error::{Error, Result};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
-use crate::forces::{RobustKernel, robust_weights, row_springs, spring_system};
+use crate::forces::{PatchAssembly, RobustKernel, robust_weights};
 use crate::limit::{ClosestPointEngine, ClosestPointParams};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
@@ -116,8 +117,12 @@ pub fn fit_point_cloud(
         let s = table.to_level();
         let area = parameter_area(table);
         let material = MaterialParams::thin_plate(params.tension, params.bending, area);
-        let k = patch_stiffness_matrix(table, params.quadrature_order, &material)?;
-        let d = patch_damping_matrix(table, params.quadrature_order, params.damping / area)?;
+        let [k, d] = patch_stiffness_and_damping(
+            table,
+            params.quadrature_order,
+            &material,
+            params.damping / area,
+        )?;
         let mut kd = k.linear_combination(1.0, &d, 1.0)?;
         let m = if params.mass > 0.0 {
             let m = patch_damping_matrix(table, params.quadrature_order, params.mass / area)?;
@@ -126,7 +131,10 @@ pub fn fit_point_cloud(
         } else {
             None
         };
+        let assembly = PatchAssembly::new(table)?;
+        let kd_values = assembly.values_of(&kd)?;
         let centres = surface_samples(table, params.surface_samples).compose(s)?;
+        let per_patch = params.surface_samples * params.surface_samples;
         let mut p = mesh.positions.clone();
         // The previous step's positions (at rest when a level starts).
         let mut p_before = p.clone();
@@ -165,7 +173,7 @@ pub fn fit_point_cloud(
             // must not be dominated by outliers (the full RMS is) nor jump as
             // the robust weights admit or drop points (the inliers' RMS does).
             let trimmed = trimmed_rms(&dist, 0.95);
-            let mut springs = spring_system(&engine, used, &closest, &kw)?;
+            let mut springs = assembly.data_springs(engine.table(), used, &closest, &kw)?;
             if params.surface_weight > 0.0 {
                 // Surface-to-data springs: every surface sample to its
                 // nearest data point, so parts of the surface that no data
@@ -184,7 +192,13 @@ pub fn fit_point_cloud(
                 let m = xs.len() as Real;
                 let ks: Vec<Real> = ws.iter().map(|w| params.surface_weight * w / m).collect();
                 let targets: Vec<Point3> = near.iter().map(|n| n.0).collect();
-                springs.add(&row_springs(&centres, &xs, &targets, &ks)?)?;
+                springs.add(&assembly.row_springs(
+                    &centres,
+                    |i| i / per_patch,
+                    &xs,
+                    &targets,
+                    &ks,
+                )?)?;
             }
             let kp = k.apply(&p)?;
             let e = springs.energy
@@ -207,7 +221,10 @@ pub fn fit_point_cloud(
             if settled || steps >= params.max_steps {
                 break;
             }
-            let a = kd.linear_combination(1.0, &springs.matrix, 1.0)?;
+            let mut a = springs.matrix;
+            for (x, y) in a.weights.iter_mut().zip(&kd_values) {
+                *x += y;
+            }
             let dp = d.apply(&p)?;
             let mut rhs: Vec<Point3> = springs
                 .rhs

@@ -5,10 +5,12 @@
 
 mod image;
 mod inflation;
+mod patch_assembly;
 mod robust;
 mod springs;
 
 pub use image::{BoundaryModel, ImageField, Offset};
 pub use inflation::inflation_force;
+pub use patch_assembly::PatchAssembly;
 pub use robust::{RobustKernel, robust_weights};
 pub use springs::{SpringSystem, drag_spring, row_springs, spring_system};

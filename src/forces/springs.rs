@@ -29,8 +29,17 @@ pub struct SpringSystem {
 impl SpringSystem {
     /// Adds another spring system over the same control points (matrices,
     /// loads and energies add).
+    /// Matrices with the same pattern (as [`PatchAssembly`](super::PatchAssembly)
+    /// makes them) add entry by entry.
     pub fn add(&mut self, other: &SpringSystem) -> Result<()> {
-        self.matrix = self.matrix.linear_combination(1.0, &other.matrix, 1.0)?;
+        let (a, b) = (&self.matrix, &other.matrix);
+        if a.num_cols == b.num_cols && a.offsets == b.offsets && a.indices == b.indices {
+            for (x, y) in self.matrix.weights.iter_mut().zip(&b.weights) {
+                *x += y;
+            }
+        } else {
+            self.matrix = self.matrix.linear_combination(1.0, &other.matrix, 1.0)?;
+        }
         if self.rhs.len() != other.rhs.len() {
             return Err(Error::Input(format!(
                 "springs over {} and {} control points",

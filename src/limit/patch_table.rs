@@ -337,22 +337,54 @@ impl PatchTable {
     /// The position row of [`stencil`](Self::stencil) alone (cheaper):
     /// columns (level-`L` vertices) and weights.
     pub fn position_stencil(&self, f: usize, st: [Real; 2]) -> (Vec<u32>, Vec<Real>) {
-        if self.patches[f].regular {
-            let w = patch_weights(st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0));
-            let mut b = RowBuilder::default();
-            for (i, &wi) in w[0].iter().enumerate() {
+        let mut b = RowBuilder::default();
+        self.visit_position_weights(f, st, |c, w| b.add(c, w));
+        b.entries().unzip()
+    }
+
+    /// The terms of [`position_stencil`](Self::position_stencil) handed to
+    /// `visit(column, weight)` one by one (a column may come more than once;
+    /// its weights add), without allocating except in the innermost cell at
+    /// an irregular vertex.
+    pub fn visit_position_weights(
+        &self,
+        f: usize,
+        st: [Real; 2],
+        mut visit: impl FnMut(u32, Real),
+    ) {
+        let patch = &self.patches[f];
+        if patch.regular {
+            let [w, ..] = patch_weights(st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0));
+            for (i, &wi) in w.iter().enumerate() {
                 if wi != 0.0 {
                     let (cols, ws) = self.grid_table.row(16 * f + i);
                     for (&c, &x) in cols.iter().zip(ws) {
-                        b.add(c, wi * x);
+                        visit(c, wi * x);
                     }
                 }
             }
-            return b.entries().unzip();
+            return;
         }
-        let s = self.stencil(f, st);
-        let [w0, ..] = s.weights;
-        (s.cols, w0)
+        let tree = patch.tree.get_or_init(|| self.tree(f));
+        let nc = tree.cols.len();
+        for leaf in &tree.leaves {
+            let x = [
+                leaf.jac[0][0] * st[0] + leaf.jac[0][1] * st[1] + leaf.off[0],
+                leaf.jac[1][0] * st[0] + leaf.jac[1][1] * st[1] + leaf.off[1],
+            ];
+            let inside = x.iter().all(|c| (-1e-12..=1.0 + 1e-12).contains(c));
+            if let (Some(rows), true) = (&leaf.grid, inside) {
+                let [w, ..] = patch_weights(x[0].clamp(0.0, 1.0), x[1].clamp(0.0, 1.0));
+                for (k, &c) in tree.cols.iter().enumerate() {
+                    visit(c, (0..16).map(|i| w[i] * rows[i * nc + k]).sum());
+                }
+                return;
+            }
+        }
+        let s = evaluate_face(&self.level, &self.sharp, f, st[0], st[1]);
+        for (&c, &w) in s.cols.iter().zip(&s.weights[0]) {
+            visit(c, w);
+        }
     }
 
     /// The refinement `P_L = S P_0` from the control points to level `L`.

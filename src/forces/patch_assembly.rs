@@ -1,0 +1,342 @@
+//! Spring systems assembled straight into a fixed sparsity pattern.
+//!
+//! A limit-surface point on patch `f` depends only on the control points
+//! under `f`'s one-ring, its *support*. So every spring term `k JᵀJ`
+//! (Qin, Mandal, Vemuri 1998, eq. 15), and the thin plate `K` and damping
+//! `D` assembled patch by patch, are nonzero only on pairs of control
+//! points that share a patch support. [`PatchAssembly`] computes that
+//! pattern once per control mesh, together with each patch's position of
+//! every support pair in it; a spring then costs one dense outer product of
+//! its row over the support, scattered through the precomputed slots, in
+//! place of composing its stencil with `S` and forming `JᵀJ` by sparse
+//! products every step. The sums are the same as
+//! [`spring_system`](super::spring_system)'s to round-off (tested in
+//! `tests/forces.rs`).
+
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::limit::{ClosestPoint, PatchTable};
+use crate::math::{Point3, Real};
+use crate::stencil::StencilTable;
+
+use super::SpringSystem;
+
+/// The sparsity pattern of the control-point system of a [`PatchTable`] and
+/// each patch's support and slots in it.
+#[derive(Clone, Debug)]
+pub struct PatchAssembly {
+    /// Rows (sorted columns) of the pattern over the control points.
+    offsets: Vec<usize>,
+    indices: Vec<u32>,
+    /// Control points each patch depends on, sorted, patch after patch.
+    support_offsets: Vec<usize>,
+    support: Vec<u32>,
+    /// For patch `f` with support of size `m`: `m × m` positions in the
+    /// pattern, row-major, starting at `slot_offsets[f]`.
+    slot_offsets: Vec<usize>,
+    slots: Vec<u32>,
+    /// The largest support.
+    max_support: usize,
+}
+
+impl PatchAssembly {
+    /// Supports, pattern and slots of `table`'s patches.
+    pub fn new(table: &PatchTable) -> Result<Self> {
+        let level = table.level();
+        let s = table.to_level();
+        let n = s.num_cols;
+        let supports: Vec<Vec<u32>> = (0..table.num_patches())
+            .into_par_iter()
+            .map(|f| {
+                let mut sup = Vec::with_capacity(32);
+                for &v in level.face_vertices(f) {
+                    for &g in level.vertex_faces(v as usize) {
+                        for &w in level.face_vertices(g as usize) {
+                            sup.extend_from_slice(s.row(w as usize).0);
+                        }
+                    }
+                }
+                sup.sort_unstable();
+                sup.dedup();
+                sup
+            })
+            .collect();
+        let mut support_offsets = Vec::with_capacity(supports.len() + 1);
+        support_offsets.push(0);
+        for sup in &supports {
+            support_offsets.push(support_offsets.last().copied().unwrap_or(0) + sup.len());
+        }
+        let support: Vec<u32> = supports.concat();
+        // The patches over each control point, then each row's columns.
+        let mut count = vec![0usize; n + 1];
+        for &c in &support {
+            count[c as usize + 1] += 1;
+        }
+        for i in 0..n {
+            count[i + 1] += count[i];
+        }
+        let mut fill = count.clone();
+        let mut patches_of = vec![0u32; support.len()];
+        for (f, w) in support_offsets.windows(2).enumerate() {
+            for &c in &support[w[0]..w[1]] {
+                patches_of[fill[c as usize]] = f as u32;
+                fill[c as usize] += 1;
+            }
+        }
+        let rows: Vec<Vec<u32>> = (0..n)
+            .into_par_iter()
+            .map(|c| {
+                let mut row: Vec<u32> = patches_of[count[c]..count[c + 1]]
+                    .iter()
+                    .flat_map(|&f| &supports[f as usize])
+                    .copied()
+                    .collect();
+                row.sort_unstable();
+                row.dedup();
+                row
+            })
+            .collect();
+        let mut offsets = Vec::with_capacity(n + 1);
+        offsets.push(0);
+        for r in &rows {
+            offsets.push(offsets.last().copied().unwrap_or(0) + r.len());
+        }
+        let indices = rows.concat();
+        let per_patch: Vec<Vec<u32>> = supports
+            .par_iter()
+            .map(|sup| {
+                let mut out = Vec::with_capacity(sup.len() * sup.len());
+                for &a in sup {
+                    let (lo, hi) = (offsets[a as usize], offsets[a as usize + 1]);
+                    let row = &indices[lo..hi];
+                    for b in sup {
+                        // Present by construction: `b` shares this patch with `a`.
+                        let k = row.binary_search(b).unwrap_or(0);
+                        out.push((lo + k) as u32);
+                    }
+                }
+                out
+            })
+            .collect();
+        let mut slot_offsets = Vec::with_capacity(per_patch.len() + 1);
+        slot_offsets.push(0);
+        for p in &per_patch {
+            slot_offsets.push(slot_offsets.last().copied().unwrap_or(0) + p.len());
+        }
+        if indices.len() > u32::MAX as usize {
+            return Err(Error::Input(format!(
+                "the control-point system would have {} entries, more than 2³² − 1",
+                indices.len()
+            )));
+        }
+        Ok(PatchAssembly {
+            max_support: supports.iter().map(Vec::len).max().unwrap_or(0),
+            offsets,
+            indices,
+            support_offsets,
+            support,
+            slot_offsets,
+            slots: per_patch.concat(),
+        })
+    }
+
+    /// Number of stored entries of the pattern.
+    pub fn num_entries(&self) -> usize {
+        self.indices.len()
+    }
+
+    /// The values of `m` (whose nonzeros must lie in the pattern, as those
+    /// of matrices assembled patch by patch over the same table do) in the
+    /// pattern's order.
+    pub fn values_of(&self, m: &StencilTable) -> Result<Vec<Real>> {
+        let n = self.offsets.len() - 1;
+        if m.num_rows() != n || m.num_cols != n {
+            return Err(Error::Input(format!(
+                "a {}×{} matrix for a system of {n} control points",
+                m.num_rows(),
+                m.num_cols
+            )));
+        }
+        let mut values = vec![0.0; self.indices.len()];
+        for r in 0..n {
+            let (lo, hi) = (self.offsets[r], self.offsets[r + 1]);
+            let row = &self.indices[lo..hi];
+            let (cols, ws) = m.row(r);
+            for (c, &w) in cols.iter().zip(ws) {
+                match row.binary_search(c) {
+                    Ok(k) => values[lo + k] += w,
+                    Err(_) if w == 0.0 => {}
+                    Err(_) => {
+                        return Err(Error::Input(format!(
+                            "matrix entry ({r}, {c}) = {w} lies outside the patches' supports"
+                        )));
+                    }
+                }
+            }
+        }
+        Ok(values)
+    }
+
+    /// The matrix with `values` in the pattern.
+    pub fn matrix(&self, values: Vec<Real>) -> StencilTable {
+        debug_assert_eq!(values.len(), self.indices.len());
+        StencilTable {
+            num_cols: self.offsets.len() - 1,
+            offsets: self.offsets.clone(),
+            indices: self.indices.clone(),
+            weights: values,
+        }
+    }
+
+    /// Springs from `points[i]` to their closest points `closest[i]` with
+    /// stiffness `k[i]`: the same system as
+    /// [`spring_system`](super::spring_system), its matrix in the pattern.
+    pub fn data_springs(
+        &self,
+        table: &PatchTable,
+        points: &[Point3],
+        closest: &[ClosestPoint],
+        k: &[Real],
+    ) -> Result<SpringSystem> {
+        check_lengths(points.len(), closest.len(), k.len())?;
+        let s = table.to_level();
+        self.springs(points.len(), |i, u| {
+            let (f, st) = closest[i].patch;
+            let sup = self.support_of(f as usize);
+            let mut outside = None;
+            table.visit_position_weights(f as usize, st, |c, wc| {
+                let (cc, sw) = s.row(c as usize);
+                for (&ctrl, &x) in cc.iter().zip(sw) {
+                    match sup.binary_search(&ctrl) {
+                        Ok(a) => u[a] += wc * x,
+                        Err(_) => outside = Some(ctrl),
+                    }
+                }
+            });
+            if let Some(c) = outside {
+                return Err(outside_support(c));
+            }
+            Ok((f as usize, closest[i].point, points[i], k[i]))
+        })
+    }
+
+    /// Springs from surface points `x[i] = rows[i] · p` on patches
+    /// `patch_of(i)` to targets `d[i]` with stiffness `k[i]`: the system of
+    /// [`row_springs`](super::row_springs), its matrix in the pattern.
+    pub fn row_springs(
+        &self,
+        rows: &StencilTable,
+        patch_of: impl Fn(usize) -> usize + Sync,
+        x: &[Point3],
+        d: &[Point3],
+        k: &[Real],
+    ) -> Result<SpringSystem> {
+        check_lengths(rows.num_rows(), x.len(), d.len())?;
+        check_lengths(rows.num_rows(), k.len(), d.len())?;
+        self.springs(d.len(), |i, u| {
+            let f = patch_of(i);
+            let sup = self.support_of(f);
+            let (cols, ws) = rows.row(i);
+            for (&c, &w) in cols.iter().zip(ws) {
+                u[position(sup, c)?] += w;
+            }
+            Ok((f, x[i], d[i], k[i]))
+        })
+    }
+
+    fn support_of(&self, f: usize) -> &[u32] {
+        &self.support[self.support_offsets[f]..self.support_offsets[f + 1]]
+    }
+
+    /// Sums `k uuᵀ`, `k u d` and `½ k |x − d|²` over `count` springs;
+    /// `spring(i, u)` writes spring `i`'s row over its patch's support into
+    /// the zeroed `u` and returns the patch, `x`, `d` and `k`.
+    fn springs(
+        &self,
+        count: usize,
+        spring: impl Fn(usize, &mut [Real]) -> Result<(usize, Point3, Point3, Real)> + Sync,
+    ) -> Result<SpringSystem> {
+        let n = self.offsets.len() - 1;
+        let chunk = count.div_ceil(rayon::current_num_threads().max(1)).max(1);
+        let parts: Vec<(Vec<Real>, Vec<Point3>, Real)> = (0..count)
+            .collect::<Vec<_>>()
+            .par_chunks(chunk)
+            .map(|ids| {
+                let mut values = vec![0.0; self.indices.len()];
+                let mut rhs = vec![Point3::origin(); n];
+                let mut energy = 0.0;
+                let mut u = Vec::new();
+                for &i in ids {
+                    u.clear();
+                    u.resize(self.max_support, 0.0);
+                    let (f, x, d, k) = spring(i, &mut u)?;
+                    if k == 0.0 {
+                        continue;
+                    }
+                    if !(k > 0.0 && k.is_finite()) {
+                        return Err(Error::Input(format!("spring {i} has stiffness {k}")));
+                    }
+                    energy += 0.5 * k * (x - d).norm_squared();
+                    let sup = self.support_of(f);
+                    let m = sup.len();
+                    let slots = &self.slots[self.slot_offsets[f]..self.slot_offsets[f + 1]];
+                    for a in 0..m {
+                        let ka = k * u[a];
+                        if ka == 0.0 {
+                            continue;
+                        }
+                        rhs[sup[a] as usize].coords += ka * d.coords;
+                        for (b, &slot) in slots[a * m..(a + 1) * m].iter().enumerate() {
+                            values[slot as usize] += ka * u[b];
+                        }
+                    }
+                }
+                Ok((values, rhs, energy))
+            })
+            .collect::<Result<_>>()?;
+        let mut parts = parts.into_iter();
+        let (mut values, mut rhs, mut energy) = parts.next().unwrap_or_else(|| {
+            (
+                vec![0.0; self.indices.len()],
+                vec![Point3::origin(); n],
+                0.0,
+            )
+        });
+        for (v, r, e) in parts {
+            for (a, b) in values.iter_mut().zip(v) {
+                *a += b;
+            }
+            for (a, b) in rhs.iter_mut().zip(r) {
+                a.coords += b.coords;
+            }
+            energy += e;
+        }
+        Ok(SpringSystem {
+            matrix: self.matrix(values),
+            rhs,
+            energy,
+        })
+    }
+}
+
+/// Where control point `c` sits in the sorted `support`.
+fn position(support: &[u32], c: u32) -> Result<usize> {
+    support.binary_search(&c).map_err(|_| outside_support(c))
+}
+
+fn outside_support(c: u32) -> Error {
+    Error::Topology(format!(
+        "control point {c} is outside its patch's one-ring support"
+    ))
+}
+
+fn check_lengths(a: usize, b: usize, c: usize) -> Result<()> {
+    if a == b && b == c {
+        Ok(())
+    } else {
+        Err(Error::Input(format!(
+            "springs: mismatched lengths {a}, {b} and {c}"
+        )))
+    }
+}
