@@ -114,7 +114,7 @@ impl Default for FitParams {
             surface_weight: 0.5,
             drop_outliers: true,
             cg_tolerance: 1e-5,
-            points_per_control_point: 20,
+            points_per_control_point: 10,
             surface_samples: 2,
             robust: RobustKernel::default(),
             patch_level: 1,

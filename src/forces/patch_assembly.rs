@@ -32,6 +32,13 @@ pub struct PatchAssembly {
     /// Control points each patch depends on, sorted, patch after patch.
     support_offsets: Vec<usize>,
     support: Vec<u32>,
+    /// The level-`L` vertices of each patch's one-ring, sorted, patch after
+    /// patch; for ring vertex `k` (counted over all patches), the columns of
+    /// its row of `S` sit at `ring_positions[ring_map[k]..]` in the support.
+    ring_offsets: Vec<usize>,
+    ring: Vec<u32>,
+    ring_map: Vec<usize>,
+    ring_positions: Vec<u16>,
     /// For patch `f` with support of size `m`: `m × m` positions in the
     /// pattern, row-major, starting at `slot_offsets[f]`.
     slot_offsets: Vec<usize>,
@@ -46,27 +53,50 @@ impl PatchAssembly {
         let level = table.level();
         let s = table.to_level();
         let n = s.num_cols;
-        let supports: Vec<Vec<u32>> = (0..table.num_patches())
+        let rings: Vec<(Vec<u32>, Vec<u32>)> = (0..table.num_patches())
             .into_par_iter()
             .map(|f| {
-                let mut sup = Vec::with_capacity(32);
+                let mut ring = Vec::with_capacity(16);
                 for &v in level.face_vertices(f) {
                     for &g in level.vertex_faces(v as usize) {
-                        for &w in level.face_vertices(g as usize) {
-                            sup.extend_from_slice(s.row(w as usize).0);
-                        }
+                        ring.extend_from_slice(level.face_vertices(g as usize));
                     }
                 }
+                ring.sort_unstable();
+                ring.dedup();
+                let mut sup: Vec<u32> = ring
+                    .iter()
+                    .flat_map(|&w| s.row(w as usize).0)
+                    .copied()
+                    .collect();
                 sup.sort_unstable();
                 sup.dedup();
-                sup
+                (ring, sup)
             })
             .collect();
-        let mut support_offsets = Vec::with_capacity(supports.len() + 1);
-        support_offsets.push(0);
-        for sup in &supports {
-            support_offsets.push(support_offsets.last().copied().unwrap_or(0) + sup.len());
+        let (rings, supports): (Vec<Vec<u32>>, Vec<Vec<u32>>) = rings.into_iter().unzip();
+        if let Some(big) = supports.iter().find(|sup| sup.len() > u16::MAX as usize) {
+            return Err(Error::Input(format!(
+                "a patch depends on {} control points, more than 65,535",
+                big.len()
+            )));
         }
+        let support_offsets = offsets_of(supports.iter().map(Vec::len));
+        let ring_offsets = offsets_of(rings.iter().map(Vec::len));
+        let ring_positions: Vec<u16> = rings
+            .iter()
+            .zip(&supports)
+            .flat_map(|(ring, sup)| {
+                ring.iter().flat_map(|&w| {
+                    s.row(w as usize)
+                        .0
+                        .iter()
+                        .map(|c| sup.binary_search(c).unwrap_or(0) as u16)
+                })
+            })
+            .collect();
+        let ring: Vec<u32> = rings.concat();
+        let ring_map = offsets_of(ring.iter().map(|&w| s.row(w as usize).0.len()));
         let support: Vec<u32> = supports.concat();
         // The patches over each control point, then each row's columns.
         let mut count = vec![0usize; n + 1];
@@ -97,11 +127,7 @@ impl PatchAssembly {
                 row
             })
             .collect();
-        let mut offsets = Vec::with_capacity(n + 1);
-        offsets.push(0);
-        for r in &rows {
-            offsets.push(offsets.last().copied().unwrap_or(0) + r.len());
-        }
+        let offsets = offsets_of(rows.iter().map(Vec::len));
         let indices = rows.concat();
         let per_patch: Vec<Vec<u32>> = supports
             .par_iter()
@@ -119,11 +145,7 @@ impl PatchAssembly {
                 out
             })
             .collect();
-        let mut slot_offsets = Vec::with_capacity(per_patch.len() + 1);
-        slot_offsets.push(0);
-        for p in &per_patch {
-            slot_offsets.push(slot_offsets.last().copied().unwrap_or(0) + p.len());
-        }
+        let slot_offsets = offsets_of(per_patch.iter().map(Vec::len));
         if indices.len() > u32::MAX as usize {
             return Err(Error::Input(format!(
                 "the control-point system would have {} entries, more than 2³² − 1",
@@ -136,6 +158,10 @@ impl PatchAssembly {
             indices,
             support_offsets,
             support,
+            ring_offsets,
+            ring,
+            ring_map,
+            ring_positions,
             slot_offsets,
             slots: per_patch.concat(),
         })
@@ -203,21 +229,25 @@ impl PatchAssembly {
         let s = table.to_level();
         self.springs(points.len(), |i, u| {
             let (f, st) = closest[i].patch;
-            let sup = self.support_of(f as usize);
+            let f = f as usize;
+            let first = self.ring_offsets[f];
+            let ring = &self.ring[first..self.ring_offsets[f + 1]];
             let mut outside = None;
-            table.visit_position_weights(f as usize, st, |c, wc| {
-                let (cc, sw) = s.row(c as usize);
-                for (&ctrl, &x) in cc.iter().zip(sw) {
-                    match sup.binary_search(&ctrl) {
-                        Ok(a) => u[a] += wc * x,
-                        Err(_) => outside = Some(ctrl),
+            table.visit_position_weights(f, st, |c, wc| match ring.binary_search(&c) {
+                Ok(j) => {
+                    let at = &self.ring_positions[self.ring_map[first + j]..];
+                    for (&x, &a) in s.row(c as usize).1.iter().zip(at) {
+                        u[a as usize] += wc * x;
                     }
                 }
+                Err(_) => outside = Some(c),
             });
             if let Some(c) = outside {
-                return Err(outside_support(c));
+                return Err(Error::Topology(format!(
+                    "level vertex {c} is outside patch {f}'s one-ring"
+                )));
             }
-            Ok((f as usize, closest[i].point, points[i], k[i]))
+            Ok((f, closest[i].point, points[i], k[i]))
         })
     }
 
@@ -322,13 +352,20 @@ impl PatchAssembly {
 
 /// Where control point `c` sits in the sorted `support`.
 fn position(support: &[u32], c: u32) -> Result<usize> {
-    support.binary_search(&c).map_err(|_| outside_support(c))
+    support.binary_search(&c).map_err(|_| {
+        Error::Topology(format!(
+            "control point {c} is outside its patch's one-ring support"
+        ))
+    })
 }
 
-fn outside_support(c: u32) -> Error {
-    Error::Topology(format!(
-        "control point {c} is outside its patch's one-ring support"
-    ))
+/// Running offsets `[0, l₀, l₀ + l₁, …]` of consecutive blocks of lengths `l`.
+fn offsets_of(lengths: impl Iterator<Item = usize>) -> Vec<usize> {
+    let mut out = vec![0];
+    for l in lengths {
+        out.push(out.last().copied().unwrap_or(0) + l);
+    }
+    out
 }
 
 fn check_lengths(a: usize, b: usize, c: usize) -> Result<()> {
