@@ -40,7 +40,7 @@ use crate::mesh::{PointCloud, PolyMesh};
 use crate::subdivision::{RefineOptions, Refiner};
 
 use super::init::outliers::inlier_mask;
-use super::sampling::{shuffled, surface_samples, trimmed_rms};
+use super::sampling::{shuffled_order, surface_samples, trimmed_rms};
 use super::{ErrorStats, FitParams, FitReport, LevelReport};
 
 /// A fitted model and what it took.
@@ -82,19 +82,23 @@ pub fn fit_point_cloud(
     } else {
         vec![true; points.len()]
     };
-    let data: Vec<Point3> = points
-        .iter()
-        .zip(&keep)
-        .filter_map(|(p, &k)| k.then_some(*p))
-        .collect();
-    let data = if data.len() < 4 { points.clone() } else { data };
+    let mut data_index: Vec<usize> = (0..points.len()).filter(|&i| keep[i]).collect();
+    if data_index.len() < 4 {
+        data_index = (0..points.len()).collect();
+    }
+    let data: Vec<Point3> = data_index.iter().map(|&i| points[i]).collect();
     let outliers = points.len() - data.len();
     let data_tree: ImmutableKdTree<Real, 3> =
         ImmutableKdTree::new_from_slice(&data.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>());
     let mut mesh = init.clone();
     let mut levels = Vec::new();
-    // Each level uses a prefix of a fixed even shuffle of the points.
-    let shuffled = shuffled(&data);
+    // Each level uses a prefix of a fixed even shuffle of the points
+    // (`order`: their indices in `points`).
+    let order: Vec<usize> = shuffled_order(data.len())
+        .into_iter()
+        .map(|j| data_index[j])
+        .collect();
+    let shuffled: Vec<Point3> = order.iter().map(|&i| points[i]).collect();
     let n_all = points.len() as Real;
     let (converged, stop_reason) = loop {
         let level = levels.len();
@@ -154,7 +158,7 @@ pub fn fit_point_cloud(
             )
             .max(4)];
         let n = used.len() as Real;
-        loop {
+        let used_dist = loop {
             // Newton from the previous answers every step; every
             // `reseed_every` steps also from the nearest seed, to catch jumps
             // to another part of the surface.
@@ -219,7 +223,7 @@ pub fn fit_point_cloud(
             step_rms_pct.push(stats.rms_pct);
             step_p95_pct.push(stats.p95_pct);
             if settled || steps >= params.max_steps {
-                break;
+                break dist;
             }
             let mut a = springs.matrix;
             for (x, y) in a.weights.iter_mut().zip(&kd_values) {
@@ -255,9 +259,20 @@ pub fn fit_point_cloud(
             cg_iterations += report.iterations;
             engine.set_positions(&p)?;
             steps += 1;
+        };
+        // The error over every point: the used points' distances are the
+        // last step's (descents from the previous answers, at this surface;
+        // a descent ends on the surface, so it never understates a
+        // distance), the others' from a full search.
+        let mut dist = vec![Real::NAN; points.len()];
+        for (&i, &d) in order.iter().zip(&used_dist) {
+            dist[i] = d;
         }
-        let closest = engine.closest_points(points)?;
-        let dist: Vec<Real> = closest.iter().map(|c| c.distance).collect();
+        let rest: Vec<usize> = (0..points.len()).filter(|&i| dist[i].is_nan()).collect();
+        let rest_points: Vec<Point3> = rest.iter().map(|&i| points[i]).collect();
+        for (&i, c) in rest.iter().zip(engine.closest_points(&rest_points)?) {
+            dist[i] = c.distance;
+        }
         let w = robust_weights(&dist, params.robust, 1e-6 * diameter);
         let error = ErrorStats::new(&dist, diameter);
         mesh.positions = p;

@@ -75,7 +75,7 @@ pub struct FitParams {
     /// surface has reached it. The error figures still cover every point.
     pub drop_outliers: bool,
     /// A level's springs use at most this many data points per control
-    /// point (default 20), an even subsample of the cloud: coarse levels
+    /// point (default 10), an even subsample of the cloud: coarse levels
     /// cannot resolve more, and the cost of a step follows the points used.
     /// The error of every level is still measured on all points.
     pub points_per_control_point: usize,

@@ -3,13 +3,13 @@
 //! springs, and the outlier-robust RMS of its stall test.
 
 use crate::limit::PatchTable;
-use crate::math::{Point3, Real};
+use crate::math::Real;
 use crate::stencil::StencilTable;
 
-/// `points` in a fixed pseudo-random order (a multiplicative hash of the
-/// index), so that every prefix is an even subsample of the cloud.
-pub(super) fn shuffled(points: &[Point3]) -> Vec<Point3> {
-    let mut order: Vec<(u64, usize)> = (0..points.len())
+/// `0..n` in a fixed pseudo-random order (a multiplicative hash of the
+/// index), so that every prefix is an even subsample of a cloud.
+pub(super) fn shuffled_order(n: usize) -> Vec<usize> {
+    let mut order: Vec<(u64, usize)> = (0..n)
         .map(|i| {
             (
                 (i as u64 + 1)
@@ -20,7 +20,7 @@ pub(super) fn shuffled(points: &[Point3]) -> Vec<Point3> {
         })
         .collect();
     order.sort_unstable();
-    order.into_iter().map(|(_, i)| points[i]).collect()
+    order.into_iter().map(|(_, i)| i).collect()
 }
 
 /// `per_side × per_side` cell centres of every patch of `table` (rows over
