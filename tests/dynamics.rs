@@ -7,7 +7,7 @@ use common::{default_refiner, reference_mesh};
 use subdyn::dynamics::{
     MaterialParams, PcgParams, damping_matrix, gauss_legendre, mass_matrix, patch_damping_matrix,
     patch_sample_rows, patch_samples, patch_stiffness_and_damping, patch_stiffness_matrix, pcg,
-    quadrature, stiffness_matrix,
+    quadrature, stiffness_and_damping_elements, stiffness_matrix,
 };
 use subdyn::limit::{LimitEvaluator, PatchTable, tessellate};
 use subdyn::math::{Point3, Real};
@@ -559,6 +559,20 @@ fn patch_assembly_equals_the_sparse_spring_products() {
         let carried = assembly.matrix(assembly.values_of(&stiffness).unwrap());
         let (worst, m) = table_difference(&stiffness, &carried);
         assert!(worst <= 1e-15 * m, "K in the pattern {worst:e} of {m:e}");
+        // The elements carried patch by patch equal the sparse `Sᵀ K_L S`.
+        let params = MaterialParams::default();
+        let elements = stiffness_and_damping_elements(table, 4, &params, 0.3).unwrap();
+        let reference = patch_stiffness_and_damping(table, 4, &params, 0.3).unwrap();
+        for (i, reference) in reference.iter().enumerate() {
+            let values = assembly
+                .values_of_elements(table, |f| (&elements[f].0, &elements[f].1[i][..]))
+                .unwrap();
+            let (worst, m) = table_difference(reference, &assembly.matrix(values));
+            assert!(
+                m > 0.0 && worst <= 1e-12 * m,
+                "element {i}: {worst:e} of {m:e}"
+            );
+        }
     }
     // On a 6 × 6 grid, the corners share no patch: a dense matrix is refused.
     let grid = common::grid(6, 1);

@@ -50,14 +50,31 @@ pub fn patch_stiffness_and_damping(
     params: &MaterialParams,
     gamma: Real,
 ) -> Result<[StencilTable; 2]> {
+    let elements = stiffness_and_damping_elements(table, order, params, gamma)?;
+    scattered(table, &elements)
+}
+
+/// The elements of [`patch_stiffness_and_damping`] before they are carried
+/// to the control points: for every patch, its level-`L` columns (sorted)
+/// and the row-major `K_e` and `D_e` over them.
+pub fn stiffness_and_damping_elements(
+    table: &PatchTable,
+    order: usize,
+    params: &MaterialParams,
+    gamma: Real,
+) -> Result<Vec<PatchElement<2>>> {
     params.check()?;
     damping_params(gamma).check()?;
-    assembled(
+    elements(
         table,
         order,
         [stiffness_weights(params), damping_weights(gamma)],
     )
 }
+
+/// A patch's level-`L` columns (sorted) and one row-major matrix over them
+/// per weight set.
+pub type PatchElement<const N: usize> = (Vec<u32>, [Vec<Real>; N]);
 
 /// The weights of `[J, J_u, J_v, J_uu, J_uv, J_vv]` in `K` (eq. 12).
 fn stiffness_weights(params: &MaterialParams) -> [Real; 6] {
@@ -106,23 +123,39 @@ fn assembled<const N: usize>(
     order: usize,
     c: [[Real; 6]; N],
 ) -> Result<[StencilTable; N]> {
+    scattered(table, &elements(table, order, c)?)
+}
+
+/// Every patch's element for each set of weights `c`.
+fn elements<const N: usize>(
+    table: &PatchTable,
+    order: usize,
+    c: [[Real; 6]; N],
+) -> Result<Vec<PatchElement<N>>> {
     if order == 0 || order > 16 {
         return Err(Error::Input(format!(
             "quadrature order {order} must be between 1 and 16"
         )));
     }
     let gl = gauss_legendre(order);
-    let per_patch: Vec<(Vec<u32>, [Vec<Real>; N])> = (0..table.num_patches())
+    Ok((0..table.num_patches())
         .into_par_iter()
         .map_init(Vec::new, |frames, f| {
             patch_element(table, f, &gl, c, frames)
         })
-        .collect();
+        .collect())
+}
+
+/// `Sᵀ (Σ_e K_e) S` of each weight set's elements.
+fn scattered<const N: usize>(
+    table: &PatchTable,
+    per_patch: &[PatchElement<N>],
+) -> Result<[StencilTable; N]> {
     let s = table.to_level();
     let mut out = Vec::with_capacity(N);
     for i in 0..N {
         let mut elements = Elements::new();
-        for (cols, matrices) in &per_patch {
+        for (cols, matrices) in per_patch {
             elements.push(cols, &matrices[i])?;
         }
         out.push(StencilTable::from_elements(s.num_rows(), &elements)?.pulled_back(s)?);
@@ -186,7 +219,7 @@ fn patch_element<const N: usize>(
     gl: &[(Real, Real)],
     c: [[Real; 6]; N],
     frames: &mut FrameCache<N>,
-) -> (Vec<u32>, [Vec<Real>; N]) {
+) -> PatchElement<N> {
     let (_, axes) = table.patch_frame(f);
     let (inv, det) = inverse(axes);
     let Some(grid) = table.grid_rows(f) else {

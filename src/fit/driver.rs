@@ -27,8 +27,8 @@
 use std::time::Instant;
 
 use crate::dynamics::{
-    MaterialParams, PcgParams, parameter_area, patch_damping_matrix, patch_stiffness_and_damping,
-    pcg,
+    MaterialParams, PcgParams, parameter_area, patch_damping_matrix, pcg,
+    stiffness_and_damping_elements,
 };
 use crate::error::{Error, Result};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
@@ -121,22 +121,33 @@ pub fn fit_point_cloud(
         let s = table.to_level();
         let area = parameter_area(table);
         let material = MaterialParams::thin_plate(params.tension, params.bending, area);
-        let [k, d] = patch_stiffness_and_damping(
+        let assembly = PatchAssembly::new(table)?;
+        let elements = stiffness_and_damping_elements(
             table,
             params.quadrature_order,
             &material,
             params.damping / area,
         )?;
-        let mut kd = k.linear_combination(1.0, &d, 1.0)?;
+        let carried = |i: usize| {
+            assembly.values_of_elements(table, |f| (&elements[f].0, &elements[f].1[i][..]))
+        };
+        let (k, d) = (assembly.matrix(carried(0)?), assembly.matrix(carried(1)?));
+        let mut kd_values: Vec<Real> = k
+            .weights
+            .iter()
+            .zip(&d.weights)
+            .map(|(a, b)| a + b)
+            .collect();
+        drop(elements);
         let m = if params.mass > 0.0 {
             let m = patch_damping_matrix(table, params.quadrature_order, params.mass / area)?;
-            kd = kd.linear_combination(1.0, &m, 1.0)?;
+            for (x, y) in kd_values.iter_mut().zip(assembly.values_of(&m)?) {
+                *x += y;
+            }
             Some(m)
         } else {
             None
         };
-        let assembly = PatchAssembly::new(table)?;
-        let kd_values = assembly.values_of(&kd)?;
         let centres = surface_samples(table, params.surface_samples).compose(s)?;
         let per_patch = params.surface_samples * params.surface_samples;
         let mut p = mesh.positions.clone();

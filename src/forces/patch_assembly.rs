@@ -204,6 +204,85 @@ impl PatchAssembly {
         Ok(values)
     }
 
+    /// `Σ_f S_fᵀ E_f S_f` in the pattern's order: the dense element
+    /// `element(f) = (cols, E_f)` of every patch `f` over level-`L`
+    /// vertices of its one-ring (`cols` sorted, `E_f` row-major), carried to
+    /// the control points through the patch's rows `S_f` of `S` — the
+    /// finite-element scatter and `Sᵀ K_L S` in one pass.
+    pub fn values_of_elements<'a>(
+        &self,
+        table: &PatchTable,
+        element: impl Fn(usize) -> (&'a [u32], &'a [Real]) + Sync,
+    ) -> Result<Vec<Real>> {
+        let s = table.to_level();
+        let patches = self.ring_offsets.len() - 1;
+        let chunk = patches.div_ceil(rayon::current_num_threads().max(1)).max(1);
+        let parts: Vec<Vec<Real>> = (0..patches)
+            .collect::<Vec<_>>()
+            .par_chunks(chunk)
+            .map(|fs| {
+                let mut values = vec![0.0; self.indices.len()];
+                let (mut t, mut c) = (Vec::new(), Vec::new());
+                for &f in fs {
+                    let (cols, e) = element(f);
+                    let m = cols.len();
+                    if e.len() != m * m {
+                        return Err(Error::Input(format!(
+                            "patch {f}'s element has {} entries for {m} columns",
+                            e.len()
+                        )));
+                    }
+                    let first = self.ring_offsets[f];
+                    let ring = &self.ring[first..self.ring_offsets[f + 1]];
+                    // Each column's row of S: its weights and support positions.
+                    let rows = cols
+                        .iter()
+                        .map(|&col| {
+                            let j = ring.binary_search(&col).map_err(|_| {
+                                Error::Topology(format!(
+                                    "level vertex {col} is outside patch {f}'s one-ring"
+                                ))
+                            })?;
+                            Ok((
+                                s.row(col as usize).1,
+                                &self.ring_positions[self.ring_map[first + j]..],
+                            ))
+                        })
+                        .collect::<Result<Vec<_>>>()?;
+                    let n = self.support_offsets[f + 1] - self.support_offsets[f];
+                    // T = E S_f (m × n), then C = S_fᵀ T (n × n).
+                    t.clear();
+                    t.resize(m * n, 0.0);
+                    for (j, (w, at)) in rows.iter().enumerate() {
+                        for (&x, &b) in w.iter().zip(*at) {
+                            for i in 0..m {
+                                t[i * n + b as usize] += e[i * m + j] * x;
+                            }
+                        }
+                    }
+                    c.clear();
+                    c.resize(n * n, 0.0);
+                    for (i, (w, at)) in rows.iter().enumerate() {
+                        for (&x, &a) in w.iter().zip(*at) {
+                            let a = a as usize;
+                            for (o, &y) in
+                                c[a * n..(a + 1) * n].iter_mut().zip(&t[i * n..(i + 1) * n])
+                            {
+                                *o += x * y;
+                            }
+                        }
+                    }
+                    let slots = &self.slots[self.slot_offsets[f]..self.slot_offsets[f + 1]];
+                    for (&slot, &x) in slots.iter().zip(&c) {
+                        values[slot as usize] += x;
+                    }
+                }
+                Ok(values)
+            })
+            .collect::<Result<_>>()?;
+        Ok(summed(parts, self.indices.len()))
+    }
+
     /// The matrix with `values` in the pattern.
     pub fn matrix(&self, values: Vec<Real>) -> StencilTable {
         debug_assert_eq!(values.len(), self.indices.len());
@@ -325,23 +404,17 @@ impl PatchAssembly {
                 Ok((values, rhs, energy))
             })
             .collect::<Result<_>>()?;
-        let mut parts = parts.into_iter();
-        let (mut values, mut rhs, mut energy) = parts.next().unwrap_or_else(|| {
-            (
-                vec![0.0; self.indices.len()],
-                vec![Point3::origin(); n],
-                0.0,
-            )
-        });
+        let mut rhs = vec![Point3::origin(); n];
+        let mut energy = 0.0;
+        let mut values = Vec::with_capacity(parts.len());
         for (v, r, e) in parts {
-            for (a, b) in values.iter_mut().zip(v) {
-                *a += b;
-            }
+            values.push(v);
             for (a, b) in rhs.iter_mut().zip(r) {
                 a.coords += b.coords;
             }
             energy += e;
         }
+        let values = summed(values, self.indices.len());
         Ok(SpringSystem {
             matrix: self.matrix(values),
             rhs,
@@ -357,6 +430,18 @@ fn position(support: &[u32], c: u32) -> Result<usize> {
             "control point {c} is outside its patch's one-ring support"
         ))
     })
+}
+
+/// The entrywise sum of `parts` (zeros of length `len` if there are none).
+fn summed(parts: Vec<Vec<Real>>, len: usize) -> Vec<Real> {
+    let mut parts = parts.into_iter();
+    let mut out = parts.next().unwrap_or_else(|| vec![0.0; len]);
+    for p in parts {
+        for (a, b) in out.iter_mut().zip(p) {
+            *a += b;
+        }
+    }
+    out
 }
 
 /// Running offsets `[0, l₀, l₀ + l₁, …]` of consecutive blocks of lengths `l`.
