@@ -12,8 +12,8 @@ mod common;
 
 use common::*;
 use subdyn::limit::{
-    ClosestPointEngine, ClosestPointParams, LimitEvaluator, LimitPoint, Sample, cubic_basis,
-    limit_stencil, tessellate,
+    ClosestPointEngine, ClosestPointParams, LimitEvaluator, LimitPoint, PatchTable, Sample,
+    cubic_basis, limit_stencil, tessellate,
 };
 use subdyn::math::{Point3, Vector3};
 use subdyn::mesh::PolyMesh;
@@ -1071,5 +1071,34 @@ fn local_descents_after_a_small_move_match_full_searches() {
             f.distance,
             g.distance
         );
+    }
+}
+
+/// Patch `f` of a level-1 table is base face `f` of the once-refined mesh,
+/// in the same `(s, t)` frame (the fit carries its closest points from one
+/// level to the next this way): `locate` on the refined mesh's table finds
+/// the same limit point, on meshes with irregular vertices, boundaries and
+/// n-gons.
+#[test]
+fn level_one_patches_are_the_refined_meshs_faces() {
+    let mut rng = Rng::new(5);
+    for mesh in [mixed_mesh(), pentagonal_pyramid(), subdyn::examples::cube()] {
+        let r = default_refiner(&mesh);
+        let coarse = PatchTable::new(&r, &mesh.positions, 1).unwrap();
+        let h = r.refine_uniform(1).unwrap();
+        let fine_mesh = h.mesh(1, h.stencil(0).apply(&mesh.positions).unwrap());
+        let fine = PatchTable::new(&default_refiner(&fine_mesh), &fine_mesh.positions, 1).unwrap();
+        assert_eq!(coarse.num_patches(), fine_mesh.num_faces());
+        let scale = diag(&mesh.positions);
+        for f in 0..coarse.num_patches() {
+            let st = [rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0)];
+            let a = coarse.eval(f, st).unwrap().p;
+            let (g, gst) = fine.locate(f, st[0], st[1]);
+            let b = fine.eval(g, gst).unwrap().p;
+            assert!(
+                (a - b).norm() <= 1e-12 * scale,
+                "patch {f} at {st:?}: {a} vs {b}"
+            );
+        }
     }
 }

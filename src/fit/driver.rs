@@ -100,6 +100,7 @@ pub fn fit_point_cloud(
         .collect();
     let shuffled: Vec<Point3> = order.iter().map(|&i| points[i]).collect();
     let n_all = points.len() as Real;
+    let mut carried_hints: Option<Vec<(u32, [Real; 2])>> = None;
     let (converged, stop_reason) = loop {
         let level = levels.len();
         let level_start = Instant::now();
@@ -158,18 +159,29 @@ pub fn fit_point_cloud(
             (Vec::new(), Vec::new(), Vec::new());
         let mut cg_iterations = 0;
         let mut steps = 0;
-        let mut hints: Option<Vec<(u32, [Real; 2])>> = None;
+        // The previous level's answers, in this level's patches: its patch
+        // `f` is this level's base face `f` (one uniform refinement apart),
+        // with the same corner frame.
+        let mut hints: Option<Vec<(u32, [Real; 2])>> = carried_hints.take().map(|h| {
+            h.iter()
+                .map(|&(f, st)| {
+                    let (g, st) = engine.table().locate(f as usize, st[0], st[1]);
+                    (g as u32, st)
+                })
+                .collect()
+        });
         let mut trimmed_before: Option<Real> = None;
+        let per_point = if level == 0 {
+            params.first_level_points_per_control_point
+        } else {
+            params.points_per_control_point
+        };
         let used = &shuffled[..shuffled
             .len()
-            .min(
-                params
-                    .points_per_control_point
-                    .saturating_mul(mesh.num_vertices()),
-            )
+            .min(per_point.saturating_mul(mesh.num_vertices()))
             .max(4)];
         let n = used.len() as Real;
-        let used_dist = loop {
+        let (used_dist, last_hints) = loop {
             // Newton from the previous answers every step; every
             // `reseed_every` steps also from the nearest seed, to catch jumps
             // to another part of the surface.
@@ -177,7 +189,13 @@ pub fn fit_point_cloud(
                 Some(h) if steps % params.reseed_every != 0 => {
                     engine.closest_points_local(used, h)?
                 }
-                Some(h) => engine.closest_points_near(used, h)?,
+                // A previous level's answers cover a prefix of the points.
+                Some(h) => {
+                    let k = h.len().min(used.len());
+                    let mut c = engine.closest_points_near(&used[..k], &h[..k])?;
+                    c.extend(engine.closest_points(&used[k..])?);
+                    c
+                }
                 None => engine.closest_points(used)?,
             };
             hints = Some(closest.iter().map(|c| c.patch).collect());
@@ -234,7 +252,7 @@ pub fn fit_point_cloud(
             step_rms_pct.push(stats.rms_pct);
             step_p95_pct.push(stats.p95_pct);
             if settled || steps >= params.max_steps {
-                break dist;
+                break (dist, hints);
             }
             let mut a = springs.matrix;
             for (x, y) in a.weights.iter_mut().zip(&kd_values) {
@@ -341,6 +359,7 @@ pub fn fit_point_cloud(
                 ),
             );
         }
+        carried_hints = last_hints;
         let p1 = h.stencil(0).apply(&mesh.positions)?;
         mesh = h.mesh(1, p1);
     };

@@ -75,10 +75,14 @@ pub struct FitParams {
     /// surface has reached it. The error figures still cover every point.
     pub drop_outliers: bool,
     /// A level's springs use at most this many data points per control
-    /// point (default 10), an even subsample of the cloud: coarse levels
+    /// point (default 20), an even subsample of the cloud: coarse levels
     /// cannot resolve more, and the cost of a step follows the points used.
     /// The error of every level is still measured on all points.
     pub points_per_control_point: usize,
+    /// The same for level 0 alone (default 10): its fit only starts the
+    /// next level's, which refits every point it uses, so it needs fewer
+    /// (on the Spot scan: the same final accuracy, 0.25 s less).
+    pub first_level_points_per_control_point: usize,
     /// Relative residual at which the conjugate-gradient solve of each
     /// implicit step stops (default 1e-5): the step is re-linearised at once,
     /// so solving it further buys nothing.
@@ -114,7 +118,8 @@ impl Default for FitParams {
             surface_weight: 0.5,
             drop_outliers: true,
             cg_tolerance: 1e-5,
-            points_per_control_point: 10,
+            points_per_control_point: 20,
+            first_level_points_per_control_point: 10,
             surface_samples: 2,
             robust: RobustKernel::default(),
             patch_level: 1,
@@ -166,6 +171,13 @@ impl FitParams {
         }
         if self.points_per_control_point == 0 {
             return bad("points_per_control_point", 0.0, "expected at least 1");
+        }
+        if self.first_level_points_per_control_point == 0 {
+            return bad(
+                "first_level_points_per_control_point",
+                0.0,
+                "expected at least 1",
+            );
         }
         if !(self.cg_tolerance > 0.0 && self.cg_tolerance < 1.0) {
             return bad(
