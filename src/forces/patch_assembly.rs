@@ -9,9 +9,11 @@
 //! every support pair in it; a spring then costs one dense outer product of
 //! its row over the support, scattered through the precomputed slots, in
 //! place of composing its stencil with `S` and forming `JᵀJ` by sparse
-//! products every step. The sums are the same as
-//! [`spring_system`](super::spring_system)'s to round-off (tested in
-//! `tests/forces.rs`).
+//! products every step. The thin plate's and damping's dense patch
+//! elements are carried to the control points the same way
+//! ([`PatchAssembly::values_of_elements`]). The sums are the same as
+//! [`spring_system`](super::spring_system)'s and the sparse `Sᵀ K_L S`'s to
+//! round-off (`tests/dynamics.rs`).
 
 use rayon::prelude::*;
 
