@@ -74,6 +74,34 @@ impl LocalPatch {
         }
     }
 
+    /// Everything the local subdivision of this patch depends on besides
+    /// `cols` (its rows are the identity): local topology, sharpness and the
+    /// face followed. Patches with equal keys refine to equal weights.
+    pub(crate) fn shape_key(&self) -> Vec<u64> {
+        let l = &self.level;
+        let mut key = Vec::with_capacity(
+            2 + l.face_offsets.len()
+                + l.face_verts.len()
+                + self.sharp.edge.len()
+                + self.sharp.vertex.len(),
+        );
+        key.extend([self.face as u64, l.num_vertices as u64]);
+        key.extend(
+            l.face_offsets
+                .iter()
+                .chain(&l.face_verts)
+                .map(|&x| x as u64),
+        );
+        key.extend(
+            self.sharp
+                .edge
+                .iter()
+                .chain(&self.sharp.vertex)
+                .map(|x| x.to_bits()),
+        );
+        key
+    }
+
     fn ncols(&self) -> usize {
         self.cols.len()
     }

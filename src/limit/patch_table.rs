@@ -12,11 +12,15 @@
 //!
 //! Everything but the positions is built once: the patches' control points
 //! are one stencil table over the level-`L` vertices, and the quadtree leaves
-//! keep weights, not points. [`PatchTable::set_positions`] moves the control
+//! keep weights, not points. The weights depend on the face's one-ring
+//! topology and sharpness alone, so faces whose one-rings have the same
+//! local structure (in a cage, most faces at extraordinary vertices of one
+//! valence) share one set. [`PatchTable::set_positions`] moves the control
 //! mesh (as fitting does every step) with two sparse products.
 
+use std::collections::HashMap;
 use std::ops::{Add, Mul};
-use std::sync::OnceLock;
+use std::sync::{Arc, Mutex, OnceLock};
 
 use rayon::prelude::*;
 
@@ -64,7 +68,7 @@ struct Tree {
 struct Leaf {
     jac: [[Real; 2]; 2],
     off: [Real; 2],
-    grid: Option<Vec<Real>>,
+    grid: Option<Arc<Vec<Real>>>,
     /// The control points at the current positions (cleared by `set_positions`).
     points: OnceLock<[Point3; 16]>,
 }
@@ -94,6 +98,10 @@ pub struct PatchTable {
     /// Face offsets of levels `0..L`, to locate a base `(face, u, v)`.
     offsets: Vec<Vec<u32>>,
     patches: Vec<Patch>,
+    /// Quadtree leaves by the one-ring's [`LocalPatch::shape_key`]:
+    /// irregular faces with the same local structure (most faces at
+    /// extraordinary vertices of one valence) share their weights.
+    shapes: Mutex<HashMap<Vec<u64>, Arc<Vec<Leaf>>>>,
 }
 
 impl PatchTable {
@@ -161,6 +169,7 @@ impl PatchTable {
                 .map(|l| l.face_offsets.clone())
                 .collect(),
             patches,
+            shapes: Mutex::new(HashMap::new()),
         };
         table.set_positions(positions)?;
         Ok(table)
@@ -276,9 +285,10 @@ impl PatchTable {
     /// [`stencil`](Self::stencil) at several points of patch `f`. An
     /// irregular patch's quadtree is used if [`stencil`](Self::stencil) or an
     /// evaluation has cached it, and otherwise built for this call alone and
-    /// dropped: the sample sets of the dynamics ([`crate::dynamics`]) visit
-    /// every patch once, and caching all the quadtrees would hold tens of
-    /// kilobytes per irregular patch for the rest of the table's life.
+    /// dropped (its weights stay shared with faces of the same structure):
+    /// the sample sets of the dynamics ([`crate::dynamics`]) visit every
+    /// patch once, and caching every patch's tree would hold its leaves'
+    /// control points for the rest of the table's life.
     pub fn stencils(&self, f: usize, sts: &[[Real; 2]]) -> Vec<SampleStencil> {
         let patch = &self.patches[f];
         if patch.regular {
@@ -488,9 +498,32 @@ impl PatchTable {
 
     /// The quadtree of irregular level-`L` face `f` (see module docs).
     fn tree(&self, f: usize) -> Tree {
-        let mut leaves = Vec::new();
         let root = LocalPatch::around(&self.level, &self.sharp, f);
         let cols = root.cols.clone();
+        let key = root.shape_key();
+        let cached = self.shapes.lock().ok().and_then(|s| s.get(&key).cloned());
+        let shape = cached.unwrap_or_else(|| {
+            let shape = Arc::new(Self::leaves(root));
+            if let Ok(mut shapes) = self.shapes.lock() {
+                shapes.insert(key, shape.clone());
+            }
+            shape
+        });
+        let leaves = shape
+            .iter()
+            .map(|l| Leaf {
+                jac: l.jac,
+                off: l.off,
+                grid: l.grid.clone(),
+                points: OnceLock::new(),
+            })
+            .collect();
+        Tree { cols, leaves }
+    }
+
+    /// The quadtree leaves of local patch `root` (weights over its `cols`).
+    fn leaves(root: LocalPatch) -> Vec<Leaf> {
+        let mut leaves = Vec::new();
         let mut stack = vec![(root, [[1.0, 0.0], [0.0, 1.0]], [0.0, 0.0], 0)];
         while let Some((patch, jac, off, depth)) = stack.pop() {
             if depth == TREE_DEPTH {
@@ -512,7 +545,7 @@ impl PatchTable {
                     leaves.push(Leaf {
                         jac: cj,
                         off: co,
-                        grid: Some(refined.grid_rows(cf)),
+                        grid: Some(Arc::new(refined.grid_rows(cf))),
                         points: OnceLock::new(),
                     });
                 } else {
@@ -520,7 +553,7 @@ impl PatchTable {
                 }
             }
         }
-        Tree { cols, leaves }
+        leaves
     }
 }
 
