@@ -77,7 +77,7 @@ pub fn tessellate(
             level.num_vertices
         )));
     }
-    let table = PatchTable::new(refiner, positions, 2)?;
+    let table = PatchTable::new(refiner, positions, 1)?;
     let split = (0..level.num_faces()).any(|f| level.face_vertices(f).len() != 4);
     let mut tiles = Vec::new();
     for f in 0..level.num_faces() {
