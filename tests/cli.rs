@@ -711,6 +711,41 @@ fn bench_closest_is_exact_and_prints_json_last_line() {
     assert_eq!(bad.status.code(), Some(1));
 }
 
+#[test]
+fn bench_fit_reports_stages_and_prints_json_last_line() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "sphere.xyz", sphere_xyz(1500).as_bytes());
+    let out = ok(&run_subdyn(
+        dir.path(),
+        &["bench", "fit", "sphere.xyz", "--repeat", "1", "--quiet"],
+    ));
+    let last = out.lines().last().expect("some output");
+    let json: Value = serde_json::from_str(last).expect("the last line is JSON");
+    assert_eq!(json["bench"], "fit");
+    assert_eq!(json["points"], 1500);
+    let fit_s = json["fit_s"].as_f64().unwrap();
+    let levels = json["levels"].as_array().unwrap();
+    assert!(!levels.is_empty(), "{last}");
+    let staged: f64 = levels
+        .iter()
+        .map(|l| {
+            ["setup_s", "steps_s", "error_s"]
+                .map(|k| l[k].as_f64().unwrap())
+                .iter()
+                .sum::<f64>()
+        })
+        .sum();
+    assert!(
+        staged > 0.0 && staged <= fit_s,
+        "stages {staged} of {fit_s}: {last}"
+    );
+    // 1,500 points are too far from the goal's 30k to judge it.
+    assert!(json["goal_met"].is_null(), "{last}");
+    assert!(out.contains("setup s"), "human-readable table: {out}");
+    let bad = run_subdyn(dir.path(), &["bench", "fit", "--repeat", "0"]);
+    assert_eq!(bad.status.code(), Some(1));
+}
+
 // ---------------------------------------------------------------- fit
 
 /// A sphere scan as an XYZ file (Fibonacci points, radius 1).

@@ -48,6 +48,9 @@ pub enum BenchCommand {
     /// embedding, one-point updates, topology memory; the last stdout line
     /// is one JSON object.
     Ffd(super::bench_ffd::BenchFfdArgs),
+    /// Fitting a range scan (default: the embedded demo scan), stage by
+    /// stage, median of several runs; the last stdout line is one JSON object.
+    Fit(super::bench_fit::BenchFitArgs),
     /// Time steps of dynamic subdivision solids on the models of McDonnell &
     /// Qin's Table 1, explicit and implicit; one JSON object per row.
     Sculpt(super::bench_sculpt::BenchSculptArgs),
@@ -93,6 +96,7 @@ pub fn run(cmd: &BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Recover(args) => super::bench_recover::bench_recover(args),
         BenchCommand::Ffd(args) => super::bench_ffd::bench_ffd(args),
         BenchCommand::Sculpt(args) => super::bench_sculpt::bench_sculpt(args),
+        BenchCommand::Fit(args) => super::bench_fit::bench_fit(args),
     }
 }
 

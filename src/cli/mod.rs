@@ -5,6 +5,7 @@ mod bench;
 mod bench_closest;
 mod bench_distance;
 mod bench_ffd;
+mod bench_fit;
 mod bench_recover;
 mod bench_sculpt;
 mod common;

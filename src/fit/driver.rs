@@ -151,6 +151,7 @@ pub fn fit_point_cloud(
         };
         let centres = surface_samples(table, params.surface_samples).compose(s)?;
         let per_patch = params.surface_samples * params.surface_samples;
+        let setup_seconds = level_start.elapsed().as_secs_f64();
         let mut p = mesh.positions.clone();
         // The previous step's positions (at rest when a level starts).
         let mut p_before = p.clone();
@@ -293,6 +294,7 @@ pub fn fit_point_cloud(
         // last step's (descents from the previous answers, at this surface;
         // a descent ends on the surface, so it never understates a
         // distance), the others' from a full search.
+        let error_start = Instant::now();
         let mut dist = vec![Real::NAN; points.len()];
         for (&i, &d) in order.iter().zip(&used_dist) {
             dist[i] = d;
@@ -312,6 +314,8 @@ pub fn fit_point_cloud(
             steps,
             cg_iterations,
             seconds: level_start.elapsed().as_secs_f64(),
+            setup_seconds,
+            error_seconds: error_start.elapsed().as_secs_f64(),
             elapsed: start.elapsed().as_secs_f64(),
             energy,
             step_elapsed,

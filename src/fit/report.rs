@@ -80,6 +80,11 @@ pub struct LevelReport {
     pub cg_iterations: usize,
     /// Wall time of the level, seconds.
     pub seconds: Real,
+    /// Of `seconds`: building the level (patch table and seed tree,
+    /// stiffness and damping, the system's pattern, surface samples).
+    pub setup_seconds: Real,
+    /// Of `seconds`: the distances of every data point at the end.
+    pub error_seconds: Real,
     /// Seconds since the fit started, at the end of this level.
     pub elapsed: Real,
     /// Total energy before each step (data springs + stiffness).
