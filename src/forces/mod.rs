@@ -13,4 +13,4 @@ pub use image::{BoundaryModel, ImageField, Offset};
 pub use inflation::inflation_force;
 pub use patch_assembly::PatchAssembly;
 pub use robust::{RobustKernel, robust_weights};
-pub use springs::{SpringSystem, drag_spring, row_springs, spring_system};
+pub use springs::{SpringSystem, drag_spring, row_springs, spread_point_springs, spring_system};

@@ -125,6 +125,79 @@ pub fn row_springs(
     })
 }
 
+/// User-placed points as springs spread over the surface: point `d_i`,
+/// whose closest surface point is `c_i`, pulls every surface sample `x_s`
+/// (rows `j` over the control points, current positions `x`) within
+/// `radius` of `c_i` towards `x_s + (d_i − c_i)`, with stiffness
+/// `k_i w_s`, `w_s ∝ (1 − r_s²/radius²)²` (Wendland's compact kernel of the
+/// sample's distance `r_s` to `c_i`), normalised to sum 1; with no sample
+/// in range the nearest one takes it all. The total pull and the energy
+/// `½ k_i |d_i − c_i|²` are those of one spring at `c_i` (Qin, Mandal,
+/// Vemuri 1998, eq. 15), but the force no longer concentrates on the few
+/// control points under `c_i` as the mesh is refined, which raises a spike:
+/// it acts on a patch of the surface as wide as `radius` at every level.
+pub fn spread_point_springs(
+    j: &StencilTable,
+    x: &[Point3],
+    points: &[Point3],
+    closest: &[ClosestPoint],
+    k: &[Real],
+    radius: Real,
+) -> Result<SpringSystem> {
+    if points.len() != closest.len() || points.len() != k.len() || j.num_rows() != x.len() {
+        return Err(Error::Input(format!(
+            "spread springs: {} points, {} closest points, {} stiffnesses; {} rows, {} samples",
+            points.len(),
+            closest.len(),
+            k.len(),
+            j.num_rows(),
+            x.len()
+        )));
+    }
+    if !(radius > 0.0 && radius.is_finite()) || x.is_empty() {
+        return Err(Error::Input(format!(
+            "spread springs need samples and a positive radius (got {radius}, {} samples)",
+            x.len()
+        )));
+    }
+    let per_point: Vec<Vec<(usize, Point3, Real)>> = points
+        .par_iter()
+        .zip(closest)
+        .zip(k)
+        .map(|((d, c), &k)| {
+            let shift = d - c.point;
+            let mut near: Vec<(usize, Real)> = x
+                .iter()
+                .enumerate()
+                .filter_map(|(s, xs)| {
+                    let q = (xs - c.point).norm_squared() / (radius * radius);
+                    (q < 1.0).then_some((s, (1.0 - q) * (1.0 - q)))
+                })
+                .collect();
+            if near.is_empty() {
+                let nearest = (0..x.len())
+                    .min_by(|&a, &b| {
+                        (x[a] - c.point)
+                            .norm_squared()
+                            .total_cmp(&(x[b] - c.point).norm_squared())
+                    })
+                    .unwrap_or(0);
+                near.push((nearest, 1.0));
+            }
+            let total: Real = near.iter().map(|n| n.1).sum();
+            near.into_iter()
+                .map(|(s, w)| (s, x[s] + shift, k * w / total))
+                .collect()
+        })
+        .collect();
+    let all: Vec<(usize, Point3, Real)> = per_point.into_iter().flatten().collect();
+    let rows: Vec<usize> = all.iter().map(|a| a.0).collect();
+    let xs: Vec<Point3> = rows.iter().map(|&s| x[s]).collect();
+    let targets: Vec<Point3> = all.iter().map(|a| a.1).collect();
+    let ks: Vec<Real> = all.iter().map(|a| a.2).collect();
+    row_springs(&j.select_rows(&rows), &xs, &targets, &ks)
+}
+
 /// A single point-drag spring of stiffness `k` pulling the surface point
 /// `at` (a closest point of `engine`) towards `target`: the interactive drag
 /// of Qin et al. 1998 (§5.2), as an implicit term.

@@ -22,7 +22,7 @@ use crate::dynamics::{
 };
 use crate::error::{Error, Result};
 use crate::fit::ErrorStats;
-use crate::forces::{ImageField, Offset, inflation_force, row_springs, spring_system};
+use crate::forces::{ImageField, Offset, inflation_force, row_springs, spread_point_springs};
 use crate::limit::{ClosestPointEngine, ClosestPointParams, PatchTable};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::PolyMesh;
@@ -124,6 +124,10 @@ pub fn recover_shape(
             )?)
         };
         let point_k = vec![params.points_weight / points.len().max(1) as Real; points.len()];
+        // User points pull a patch as wide as a level-0 control edge at
+        // every level (each subdivision halves the edges).
+        let point_radius =
+            (1u64 << level.min(30)) as Real * mean_edge_length(&mesh, &mesh.positions);
         let mut p = mesh.positions.clone();
         let mut energy: Vec<Real> = Vec::new();
         let (mut steps, mut cg_iterations, mut still) = (0, 0, false);
@@ -170,7 +174,14 @@ pub fn recover_shape(
             if let Some(engine) = &mut engine {
                 engine.set_positions(&p)?;
                 let closest = engine.closest_points(points)?;
-                springs.add(&spring_system(engine, points, &closest, &point_k)?)?;
+                springs.add(&spread_point_springs(
+                    j,
+                    &xs,
+                    points,
+                    &closest,
+                    &point_k,
+                    point_radius,
+                )?)?;
             }
             let kp = k.apply(&p)?;
             let e = springs.energy
