@@ -746,6 +746,69 @@ fn bench_fit_reports_stages_and_prints_json_last_line() {
     assert_eq!(bad.status.code(), Some(1));
 }
 
+/// On the MNI152 ventricle, level 1 follows the image worse than level 0
+/// (the thin structure pulls its springs across itself): whatever level the
+/// recovery stops at, it never returns a level that was worse than its
+/// parent — the written mesh is the last level, or the parent of a last
+/// level worse on RMS, p95 and unresolved samples.
+#[test]
+fn recover_never_returns_a_level_worse_than_its_parent() {
+    let mni = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/volumes/mni_icbm152_t1_tal_nlin_sym_09a_converted.nii.gz");
+    if !mni.exists() {
+        eprintln!("skipped: {} is not here", mni.display());
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mni = mni.display().to_string();
+    ok(&run_subdyn(
+        dir.path(),
+        &[
+            "recover",
+            &mni,
+            "--auto",
+            "--seed",
+            "-6,0,18",
+            "--dark",
+            "--iso",
+            "120",
+            "--max-level",
+            "2",
+            "-o",
+            "v.obj",
+            "--report",
+            "r.json",
+            "--quiet",
+        ],
+    ));
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    let levels = report["recover"]["levels"].as_array().unwrap();
+    let written = obj_vertices(&dir.path().join("v.obj")).len();
+    let last = levels.last().unwrap();
+    let worse = |a: &Value, b: &Value| {
+        a["offsets"]["rms"].as_f64() > b["offsets"]["rms"].as_f64()
+            && a["offsets"]["p95"].as_f64() > b["offsets"]["p95"].as_f64()
+            && a["unresolved"].as_f64() >= b["unresolved"].as_f64()
+    };
+    let expected = match levels.as_slice() {
+        [.., parent, last] if worse(last, parent) => parent,
+        _ => last,
+    };
+    assert_eq!(
+        written as u64,
+        expected["control_points"].as_u64().unwrap(),
+        "{}",
+        report["recover"]["stop_reason"]
+    );
+    for pair in levels.windows(2).take(levels.len().saturating_sub(2)) {
+        assert!(
+            !worse(&pair[1], &pair[0]),
+            "a worse level was refined further"
+        );
+    }
+}
+
 // ---------------------------------------------------------------- fit
 
 /// A sphere scan as an XYZ file (Fibonacci points, radius 1).

@@ -69,6 +69,8 @@ pub fn recover_shape(
     let voxel = prepared.smoothed.voxel_size();
     let mut mesh = init.clone();
     let mut levels: Vec<RecoverLevel> = Vec::new();
+    // The previous level's result, returned if the next one is worse.
+    let mut coarser: Option<PolyMesh> = None;
     let (converged, stop_reason) = loop {
         let level = levels.len();
         let level_start = Instant::now();
@@ -261,6 +263,25 @@ pub fn recover_shape(
             unresolved,
             search_voxels: search,
         });
+        // A finer level that follows the image worse than its parent on
+        // every count (a thin structure can pull the finer surface's
+        // springs across itself) is dropped and the parent returned.
+        if let ([.., before, last], Some(parent)) = (levels.as_slice(), &coarser)
+            && last.offsets.rms > before.offsets.rms
+            && last.offsets.p95 > before.offsets.p95
+            && last.unresolved >= before.unresolved
+        {
+            let reason = format!(
+                "level {level} followed the image worse than level {} (RMS offset {:.3} > {:.3} voxels, {:.1} % unresolved): level {} returned",
+                level - 1,
+                last.offsets.rms,
+                before.offsets.rms,
+                100.0 * last.unresolved,
+                level - 1
+            );
+            mesh = parent.clone();
+            break (false, reason);
+        }
         if offsets.p95 <= params.tolerance_voxels && unresolved < 0.01 {
             break (true, format!("tolerance met at level {level}"));
         }
@@ -296,7 +317,7 @@ pub fn recover_shape(
         }
         let h = refiner.refine_uniform(1)?;
         let p1 = h.stencil(0).apply(&mesh.positions)?;
-        mesh = h.mesh(1, p1);
+        coarser = Some(std::mem::replace(&mut mesh, h.mesh(1, p1)));
     };
     Ok(RecoverResult {
         control: mesh,
