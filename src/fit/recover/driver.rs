@@ -151,6 +151,10 @@ pub fn recover_shape(
                     let o = field.boundary_offset(&xs[i], &n, range, sample_step);
                     let target = match o {
                         Offset::Boundary(t) => xs[i] + t * n,
+                        // Refining a level that has found the boundary:
+                        // a sample with none in range is left to the thin
+                        // plate, not pushed (pushes at fine levels run away).
+                        _ if level > 0 => return (xs[i], 0.0, o),
                         Offset::Inside | Offset::Outside => {
                             xs[i] + range * field.balloon_direction(&xs[i], &n, o == Offset::Inside)
                         }
@@ -201,7 +205,7 @@ pub fn recover_shape(
                 / total;
             // While points still search for the boundary (growing from a
             // seed), the energy stays flat without being settled.
-            let settled = unresolved_area < 0.01
+            let settled = (level > 0 || unresolved_area < 0.01)
                 && (still
                     || energy.last().is_some_and(|&prev: &Real| {
                         let change = (prev - e).abs();
