@@ -61,6 +61,25 @@ struct Tree {
     leaves: Vec<Leaf>,
 }
 
+impl Tree {
+    /// The regular leaf holding `(s, t)`, its grid rows and the point in the
+    /// leaf's own `(s', t')` (clamped to the unit square); `None` in the
+    /// innermost cell at the irregular vertex.
+    fn leaf_at(&self, st: [Real; 2]) -> Option<(&Leaf, &[Real], [Real; 2])> {
+        self.leaves.iter().find_map(|leaf| {
+            let x = [
+                leaf.jac[0][0] * st[0] + leaf.jac[0][1] * st[1] + leaf.off[0],
+                leaf.jac[1][0] * st[0] + leaf.jac[1][1] * st[1] + leaf.off[1],
+            ];
+            let inside = x.iter().all(|c| (-1e-12..=1.0 + 1e-12).contains(c));
+            match (&leaf.grid, inside) {
+                (Some(rows), true) => Some((leaf, &rows[..], x.map(|c| c.clamp(0.0, 1.0)))),
+                _ => None,
+            }
+        })
+    }
+}
+
 /// A cell of an irregular face's quadtree: leaf `(s', t') = J (s, t) + c`
 /// in the face's `(s, t)`, with its 16 bicubic control points as rows over
 /// the tree's `cols`, one after the other (`None` for the innermost cell at an
@@ -217,35 +236,25 @@ impl PatchTable {
             return Ok(bicubic(grid, st));
         }
         let tree = patch.tree.get_or_init(|| self.tree(f));
-        let cols = &tree.cols;
-        let local = |l: &Leaf| {
-            [
-                l.jac[0][0] * st[0] + l.jac[0][1] * st[1] + l.off[0],
-                l.jac[1][0] * st[0] + l.jac[1][1] * st[1] + l.off[1],
-            ]
-        };
-        let inside = |x: [Real; 2]| x.iter().all(|c| (-1e-12..=1.0 + 1e-12).contains(c));
-        for leaf in &tree.leaves {
-            let x = local(leaf);
-            if let (Some(rows), true) = (&leaf.grid, inside(x)) {
-                let nc = cols.len().max(1);
-                let grid = leaf.points.get_or_init(|| {
-                    std::array::from_fn(|k| {
-                        Point3::from(
-                            rows[k * nc..(k + 1) * nc]
-                                .iter()
-                                .zip(cols)
-                                .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
-                                .sum::<Vector3>(),
-                        )
-                    })
-                });
-                let e = bicubic(grid, [x[0].clamp(0.0, 1.0), x[1].clamp(0.0, 1.0)]);
-                return Ok(PatchPoint {
-                    p: e.p,
-                    d: chain(e.d, leaf.jac),
-                });
-            }
+        if let Some((leaf, rows, x)) = tree.leaf_at(st) {
+            let cols = &tree.cols;
+            let nc = cols.len().max(1);
+            let grid = leaf.points.get_or_init(|| {
+                std::array::from_fn(|k| {
+                    Point3::from(
+                        rows[k * nc..(k + 1) * nc]
+                            .iter()
+                            .zip(cols)
+                            .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
+                            .sum::<Vector3>(),
+                    )
+                })
+            });
+            let e = bicubic(grid, x);
+            return Ok(PatchPoint {
+                p: e.p,
+                d: chain(e.d, leaf.jac),
+            });
         }
         let s = self.sample(f, st);
         let e = self
@@ -310,36 +319,29 @@ impl PatchTable {
     /// The stencil at `(s, t)` of irregular patch `f` from its quadtree.
     fn tree_stencil(&self, tree: &Tree, f: usize, st: [Real; 2]) -> SampleStencil {
         let nc = tree.cols.len();
-        for leaf in &tree.leaves {
-            let x = [
-                leaf.jac[0][0] * st[0] + leaf.jac[0][1] * st[1] + leaf.off[0],
-                leaf.jac[1][0] * st[0] + leaf.jac[1][1] * st[1] + leaf.off[1],
-            ];
-            let inside = x.iter().all(|c| (-1e-12..=1.0 + 1e-12).contains(c));
-            if let (Some(rows), true) = (&leaf.grid, inside) {
-                let w = patch_weights(x[0].clamp(0.0, 1.0), x[1].clamp(0.0, 1.0));
-                let local: [Vec<Real>; 6] = std::array::from_fn(|q| {
-                    let mut out = vec![0.0; nc];
-                    for i in 0..16 {
-                        for (o, &r) in out.iter_mut().zip(&rows[i * nc..(i + 1) * nc]) {
-                            *o += w[q][i] * r;
-                        }
-                    }
-                    out
-                });
-                let mut weights: [Vec<Real>; 6] = std::array::from_fn(|_| vec![0.0; nc]);
-                for k in 0..nc {
-                    weights[0][k] = local[0][k];
-                    let d = chain([1, 2, 3, 4, 5].map(|q| local[q][k]), leaf.jac);
-                    for q in 0..5 {
-                        weights[q + 1][k] = d[q];
+        if let Some((leaf, rows, x)) = tree.leaf_at(st) {
+            let w = patch_weights(x[0], x[1]);
+            let local: [Vec<Real>; 6] = std::array::from_fn(|q| {
+                let mut out = vec![0.0; nc];
+                for i in 0..16 {
+                    for (o, &r) in out.iter_mut().zip(&rows[i * nc..(i + 1) * nc]) {
+                        *o += w[q][i] * r;
                     }
                 }
-                return SampleStencil {
-                    cols: tree.cols.clone(),
-                    weights,
-                };
+                out
+            });
+            let mut weights: [Vec<Real>; 6] = std::array::from_fn(|_| vec![0.0; nc]);
+            for k in 0..nc {
+                weights[0][k] = local[0][k];
+                let d = chain([1, 2, 3, 4, 5].map(|q| local[q][k]), leaf.jac);
+                for q in 0..5 {
+                    weights[q + 1][k] = d[q];
+                }
             }
+            return SampleStencil {
+                cols: tree.cols.clone(),
+                weights,
+            };
         }
         evaluate_face(&self.level, &self.sharp, f, st[0], st[1])
     }
@@ -377,19 +379,12 @@ impl PatchTable {
         }
         let tree = patch.tree.get_or_init(|| self.tree(f));
         let nc = tree.cols.len();
-        for leaf in &tree.leaves {
-            let x = [
-                leaf.jac[0][0] * st[0] + leaf.jac[0][1] * st[1] + leaf.off[0],
-                leaf.jac[1][0] * st[0] + leaf.jac[1][1] * st[1] + leaf.off[1],
-            ];
-            let inside = x.iter().all(|c| (-1e-12..=1.0 + 1e-12).contains(c));
-            if let (Some(rows), true) = (&leaf.grid, inside) {
-                let [w, ..] = patch_weights(x[0].clamp(0.0, 1.0), x[1].clamp(0.0, 1.0));
-                for (k, &c) in tree.cols.iter().enumerate() {
-                    visit(c, (0..16).map(|i| w[i] * rows[i * nc + k]).sum());
-                }
-                return;
+        if let Some((_, rows, x)) = tree.leaf_at(st) {
+            let [w, ..] = patch_weights(x[0], x[1]);
+            for (k, &c) in tree.cols.iter().enumerate() {
+                visit(c, (0..16).map(|i| w[i] * rows[i * nc + k]).sum());
             }
+            return;
         }
         let s = evaluate_face(&self.level, &self.sharp, f, st[0], st[1]);
         for (&c, &w) in s.cols.iter().zip(&s.weights[0]) {
