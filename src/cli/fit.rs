@@ -8,7 +8,7 @@ use clap::{Args, ValueEnum};
 use serde_json::json;
 
 use subdyn::fit::init::InitParams;
-use subdyn::fit::{FitParams, FitReport, ToleranceStat, fit_point_cloud};
+use subdyn::fit::{FitParams, FitReport, Refinement, ToleranceStat, fit_point_cloud};
 use subdyn::io::{read_points, write_mesh};
 use subdyn::limit::tessellate;
 use subdyn::mesh::{PointCloud, PolyMesh};
@@ -31,6 +31,15 @@ pub enum TolStat {
     Rms,
     /// Mean.
     Mean,
+}
+
+/// How a level above the tolerance is refined.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum RefineMode {
+    /// Split only the faces whose data residual is above the noise.
+    Adaptive,
+    /// Split every face (the paper's scheme).
+    Uniform,
 }
 
 /// Arguments of `subdyn fit`.
@@ -58,6 +67,13 @@ pub struct FitArgs {
     /// Subdivision levels allowed above the initial mesh.
     #[arg(long, value_name = "L", default_value_t = 3)]
     pub max_level: usize,
+    /// How a level that settled above the tolerance is refined.
+    #[arg(long, value_enum, default_value_t = RefineMode::Adaptive)]
+    pub refine: RefineMode,
+    /// Adaptive refinement splits a face when its mean squared data distance
+    /// exceeds the noise variance by Z standard errors; lower splits more.
+    #[arg(long, value_name = "Z", default_value_t = FitParams::default().refine_significance)]
+    pub refine_significance: f64,
     /// Tension weight λ_t of the thin plate (α = λ_t / area).
     #[arg(long, value_name = "λ", default_value_t = FitParams::default().tension)]
     pub tension: f64,
@@ -116,6 +132,11 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             TolStat::Mean => ToleranceStat::Mean,
         },
         max_level: args.max_level,
+        refinement: match args.refine {
+            RefineMode::Adaptive => Refinement::Adaptive,
+            RefineMode::Uniform => Refinement::Uniform,
+        },
+        refine_significance: args.refine_significance,
         tension: args.tension,
         bending: args.bending,
         mass: args.mass,
@@ -268,10 +289,10 @@ fn summary(name: &str, output: &Path, limit: Option<&Path>, r: &FitReport) -> St
         r.seconds,
         r.stop_reason
     );
-    s.push_str("level  control points  steps  CG its  seconds   max %   p95 %   RMS %  mean %\n");
+    s.push_str("level  control points  steps  CG its  seconds   max %   p95 %   RMS %  mean %  refinement\n");
     for l in &r.levels {
         s.push_str(&format!(
-            "{:>5}  {:>14}  {:>5}  {:>6}  {:>7.2}  {:>6.3}  {:>6.3}  {:>6.3}  {:>6.3}\n",
+            "{:>5}  {:>14}  {:>5}  {:>6}  {:>7.2}  {:>6.3}  {:>6.3}  {:>6.3}  {:>6.3}  {}\n",
             l.level,
             thousands(l.control_points),
             l.steps,
@@ -280,7 +301,8 @@ fn summary(name: &str, output: &Path, limit: Option<&Path>, r: &FitReport) -> St
             l.error.max_pct,
             l.error.p95_pct,
             l.error.rms_pct,
-            l.error.mean_pct
+            l.error.mean_pct,
+            l.refinement
         ));
     }
     s.push_str(&format!("errors are data-to-surface distances from all points (outliers included) in % of the scan's bounding-box diagonal\ncontrol mesh written to {}\n", output.display()));

@@ -11,8 +11,15 @@
 //! closest-point refresh can only lower the spring energy, so the energy
 //! `½ Σ k |x − d|² + ½ pᵀ K p` decreases monotonically (with fixed robust
 //! weights). When it settles (relative change below the tolerance) the error
-//! is measured; above the tolerance the control mesh is subdivided — the
-//! new control points `S p` describe the same surface — and the fit goes on.
+//! is measured; above the tolerance the control mesh is subdivided and the
+//! fit goes on. Uniform refinement splits every face (the new control points
+//! `S p` describe the same surface). Adaptive refinement (the default)
+//! splits only the faces whose data residual is above the noise
+//! ([`super::refine_marks`], [`crate::subdivision::refine_marked`]) and puts
+//! the new control mesh's limit points on the parent's surface by
+//! progressive interpolation; should such a level fit worse than its parent
+//! (transitions on a very coarse mesh can bend the surface), the parent is
+//! refined uniformly instead and the report says so.
 //!
 //! With a mass (`FitParams::mass` > 0) the steps integrate the paper's
 //! second-order dynamics `M p̈ + D ṗ + K p = f_p` (eq. 16) by backward
@@ -34,14 +41,22 @@ use crate::error::{Error, Result};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 use crate::forces::{PatchAssembly, RobustKernel, robust_weights};
-use crate::limit::{ClosestPointEngine, ClosestPointParams};
+use crate::limit::{
+    ClosestPointEngine, ClosestPointParams, interpolate_limit_points, limit_stencil,
+};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
-use crate::subdivision::{RefineOptions, Refiner};
+use crate::subdivision::{RefineOptions, Refiner, close_marks, refine_marked};
+use crate::topology::face_of_corner;
 
-use super::init::outliers::inlier_mask;
+use super::init::outliers::inliers_and_noise;
+use super::refine_marks::faces_above_noise;
 use super::sampling::{shuffled_order, surface_samples, trimmed_rms};
-use super::{ErrorStats, FitParams, FitReport, LevelReport};
+use super::{ErrorStats, FitParams, FitReport, LevelReport, Refinement};
+
+/// Iterations of progressive interpolation that put a locally refined
+/// level's surface on its parent's.
+const LIMIT_ITERATIONS: usize = 60;
 
 /// A fitted model and what it took.
 #[derive(Clone, Debug)]
@@ -77,11 +92,10 @@ pub fn fit_point_cloud(
     }
     let start = Instant::now();
     // The springs' data: the points without the outliers.
-    let keep = if params.drop_outliers {
-        inlier_mask(points)
-    } else {
-        vec![true; points.len()]
-    };
+    let (mut keep, data_noise) = inliers_and_noise(points);
+    if !params.drop_outliers {
+        keep.fill(true);
+    }
     let mut data_index: Vec<usize> = (0..points.len()).filter(|&i| keep[i]).collect();
     if data_index.len() < 4 {
         data_index = (0..points.len()).collect();
@@ -91,7 +105,7 @@ pub fn fit_point_cloud(
     let data_tree: ImmutableKdTree<Real, 3> =
         ImmutableKdTree::new_from_slice(&data.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>());
     let mut mesh = init.clone();
-    let mut levels = Vec::new();
+    let mut levels: Vec<LevelReport> = Vec::new();
     // Each level uses a prefix of a fixed even shuffle of the points
     // (`order`: their indices in `points`).
     let order: Vec<usize> = shuffled_order(data.len())
@@ -101,6 +115,10 @@ pub fn fit_point_cloud(
     let shuffled: Vec<Point3> = order.iter().map(|&i| points[i]).collect();
     let n_all = points.len() as Real;
     let mut carried_hints: Option<Vec<(u32, [Real; 2])>> = None;
+    let mut refinement = String::from("initial");
+    // The parent of an adaptive level, kept to refine it uniformly instead
+    // should the adaptive level fit worse.
+    let mut adaptive_parent: Option<PolyMesh> = None;
     let (converged, stop_reason) = loop {
         let level = levels.len();
         let level_start = Instant::now();
@@ -296,18 +314,25 @@ pub fn fit_point_cloud(
         // distance), the others' from a full search.
         let error_start = Instant::now();
         let mut dist = vec![Real::NAN; points.len()];
-        for (&i, &d) in order.iter().zip(&used_dist) {
+        let last_hints = last_hints.unwrap_or_default();
+        // The control face holding each point's closest point (a level-1
+        // patch is corner `c` of a control face).
+        let face_of_patch = face_of_corner(&mesh.face_offsets);
+        let mut face = vec![0u32; points.len()];
+        for ((&i, &d), h) in order.iter().zip(&used_dist).zip(&last_hints) {
             dist[i] = d;
+            face[i] = face_of_patch[h.0 as usize];
         }
         let rest: Vec<usize> = (0..points.len()).filter(|&i| dist[i].is_nan()).collect();
         let rest_points: Vec<Point3> = rest.iter().map(|&i| points[i]).collect();
         for (&i, c) in rest.iter().zip(engine.closest_points(&rest_points)?) {
             dist[i] = c.distance;
+            face[i] = face_of_patch[c.patch.0 as usize];
         }
         let w = robust_weights(&dist, params.robust, 1e-6 * diameter);
         let error = ErrorStats::new(&dist, diameter);
         mesh.positions = p;
-        levels.push(LevelReport {
+        let report = LevelReport {
             level,
             control_points: mesh.num_vertices(),
             faces: mesh.num_faces(),
@@ -324,7 +349,24 @@ pub fn fit_point_cloud(
             error,
             points_used: used.len(),
             rejected: w.iter().filter(|&&w| w == 0.0).count() as Real / n_all,
-        });
+            refinement: std::mem::take(&mut refinement),
+        };
+        if let (Some(parent), Some(before)) = (adaptive_parent.take(), levels.last())
+            && report.error.p95 > before.error.p95
+            && report.error.rms > before.error.rms
+        {
+            // Transitions on a coarse mesh can bend the surface more than the
+            // split faces gain; refine the parent uniformly instead.
+            refinement = format!(
+                "uniform, after an adaptive level ({} control points) that fitted worse than its parent (95th percentile {:.3} % against {:.3} %)",
+                report.control_points, report.error.p95_pct, before.error.p95_pct
+            );
+            let h = Refiner::new(&parent, &RefineOptions::default())?.refine_uniform(1)?;
+            let p1 = h.stencil(0).apply(&parent.positions)?;
+            mesh = h.mesh(1, p1);
+            continue;
+        }
+        levels.push(report);
         let stat = params.tolerance_stat;
         if error.pct(stat) <= params.tolerance_pct {
             break (true, format!("tolerance met at level {level}"));
@@ -351,21 +393,68 @@ pub fn fit_point_cloud(
             );
         }
         let h = refiner.refine_uniform(1)?;
-        if h.level(1).num_vertices as Real > params.max_control_fraction * n_all {
+        let next = match params.refinement {
+            Refinement::Uniform => {
+                refinement = "uniform".into();
+                let p1 = h.stencil(0).apply(&mesh.positions)?;
+                h.mesh(1, p1)
+            }
+            Refinement::Adaptive => {
+                let (marks, _) = faces_above_noise(
+                    mesh.num_faces(),
+                    &face,
+                    &dist,
+                    &w,
+                    data_noise,
+                    params.refine_significance,
+                );
+                if !marks.contains(&true) {
+                    break (
+                        false,
+                        format!(
+                            "no face of level {level} is off the data by more than the noise: finer levels would fit the noise"
+                        ),
+                    );
+                }
+                let marks = close_marks(h.level(0), &marks);
+                let local = refine_marked(&mesh, h.level(0), h.stencil(0), &marks)?;
+                // Start from the parent's surface: every child vertex's limit
+                // point on the parent's limit point it stands for.
+                let parent_limit = limit_stencil(&h, 1)?.apply(&mesh.positions)?;
+                let targets: Vec<Point3> = local
+                    .uniform_vertex
+                    .iter()
+                    .map(|&u| parent_limit[u as usize])
+                    .collect();
+                let (p, _) = interpolate_limit_points(&local.mesh, &targets, LIMIT_ITERATIONS)?;
+                refinement = format!(
+                    "adaptive: {} of {} faces split",
+                    marks.iter().filter(|&&m| m).count(),
+                    marks.len()
+                );
+                adaptive_parent = Some(mesh.clone());
+                PolyMesh {
+                    positions: p,
+                    ..local.mesh
+                }
+            }
+        };
+        if next.num_vertices() as Real > params.max_control_fraction * n_all {
             break (
                 false,
                 format!(
                     "level {} would have {} control points, more than {} × the {} data points",
                     level + 1,
-                    h.level(1).num_vertices,
+                    next.num_vertices(),
                     params.max_control_fraction,
                     points.len()
                 ),
             );
         }
-        carried_hints = last_hints;
-        let p1 = h.stencil(0).apply(&mesh.positions)?;
-        mesh = h.mesh(1, p1);
+        if params.refinement == Refinement::Uniform {
+            carried_hints = Some(last_hints);
+        }
+        mesh = next;
     };
     Ok(FitResult {
         control: mesh,

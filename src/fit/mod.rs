@@ -7,9 +7,10 @@ mod driver;
 pub mod init;
 mod params;
 pub mod recover;
+pub mod refine_marks;
 mod report;
 mod sampling;
 
 pub use driver::{FitResult, fit_point_cloud};
-pub use params::{FitParams, ToleranceStat};
+pub use params::{FitParams, Refinement, ToleranceStat};
 pub use report::{ErrorStats, FitReport, LevelReport};

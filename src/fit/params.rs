@@ -18,6 +18,20 @@ pub enum ToleranceStat {
     Mean,
 }
 
+/// How a level that settled above the tolerance is refined.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Refinement {
+    /// Every face is split (uniform Catmull-Clark, the paper's scheme): the
+    /// new control points describe the same surface.
+    Uniform,
+    /// Only the faces whose data residual is above the noise are split
+    /// ([`faces_above_noise`](super::refine_marks::faces_above_noise),
+    /// [`refine_marked`](crate::subdivision::refine_marked)): fewer control
+    /// points for the same accuracy where the shape is simple in places. The
+    /// default.
+    Adaptive,
+}
+
 /// Options of [`fit_point_cloud`](super::fit_point_cloud). Distances are in %
 /// of the data's bounding-box diagonal (the object's diameter).
 #[derive(Clone, Debug, PartialEq)]
@@ -43,6 +57,12 @@ pub struct FitParams {
     /// seed sample, which catches a point whose closest surface part has
     /// changed but needs the seeds' k-d tree rebuilt.
     pub reseed_every: usize,
+    /// Uniform or adaptive refinement between levels (default
+    /// [`Refinement::Adaptive`]).
+    pub refinement: Refinement,
+    /// Adaptive refinement splits a face when its mean squared data distance
+    /// exceeds the noise variance by this many standard errors (default 3).
+    pub refine_significance: Real,
     /// Stop subdividing when a level lowers the `tolerance_stat` error by
     /// less than this fraction (default 0.1): finer levels would fit the noise.
     pub min_level_gain: Real,
@@ -109,6 +129,8 @@ impl Default for FitParams {
             energy_tolerance: 1e-3,
             error_tolerance: 0.01,
             reseed_every: 4,
+            refinement: Refinement::Adaptive,
+            refine_significance: 3.0,
             min_level_gain: 0.1,
             max_control_fraction: 0.5,
             tension: 1e-5,
@@ -164,6 +186,7 @@ impl FitParams {
             ("damping", self.damping),
             ("mass", self.mass),
             ("surface_weight", self.surface_weight),
+            ("refine_significance", self.refine_significance),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(name, v, "must be finite and ≥ 0");
@@ -198,6 +221,13 @@ impl FitParams {
         }
         if !(1..=4).contains(&self.patch_level) {
             return bad("patch_level", self.patch_level as Real, "expected 1 to 4");
+        }
+        if self.refinement == Refinement::Adaptive && self.patch_level != 1 {
+            return bad(
+                "patch_level",
+                self.patch_level as Real,
+                "adaptive refinement needs patch_level 1",
+            );
         }
         if !(2..=8).contains(&self.quadrature_order) {
             return bad(

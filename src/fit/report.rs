@@ -102,6 +102,11 @@ pub struct LevelReport {
     pub error: ErrorStats,
     /// Fraction of data points whose robust weight is zero (rejected outliers).
     pub rejected: Real,
+    /// How this level came from the previous one: `initial`, `uniform`,
+    /// `adaptive: F of N faces split`, or `uniform, after an adaptive level
+    /// that fitted worse than its parent` (see
+    /// [`Refinement::Adaptive`](super::Refinement)).
+    pub refinement: String,
 }
 
 /// The whole fit.

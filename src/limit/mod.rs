@@ -4,6 +4,7 @@
 mod bspline;
 mod closest;
 mod evaluator;
+mod interpolate;
 mod limit_stencil;
 mod patch;
 mod patch_table;
@@ -13,6 +14,7 @@ mod vertex_masks;
 pub use bspline::{cubic_basis, patch_weights};
 pub use closest::{ClosestPoint, ClosestPointEngine, ClosestPointParams};
 pub use evaluator::{LimitEvaluator, LimitPoint, LimitStencils, Sample};
+pub use interpolate::interpolate_limit_points;
 pub use limit_stencil::{limit_stencil, limit_tangent_stencils};
 pub use patch::SampleStencil;
 pub(crate) use patch_table::chain as chain_rule;

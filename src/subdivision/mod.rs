@@ -1,10 +1,11 @@
 //! Refinement as stencil tables: uniform Catmull-Clark (`P_{k+1} = S_k P_k`),
-//! Doo-Sabin, non-uniform Catmull-Clark with knot intervals, and uniform
+//! local refinement of marked faces, Doo-Sabin, non-uniform Catmull-Clark with knot intervals, and uniform
 //! quadratic / cubic B-spline subdivision curves (`curves`).
 
 mod catmull_clark;
 mod curves;
 mod doo_sabin;
+mod local_refine;
 mod non_uniform;
 mod refine_topology;
 mod refiner;
@@ -15,6 +16,7 @@ pub use doo_sabin::{
     DooSabinHierarchy, DooSabinStep, doo_sabin_faces, doo_sabin_refine, doo_sabin_step,
     doo_sabin_weight,
 };
+pub use local_refine::{LocalRefinement, close_marks, refine_marked};
 pub use non_uniform::{NonUniformHierarchy, check_intervals, non_uniform_step};
 pub use refine_topology::refine_topology;
 pub use refiner::{BoundaryRule, Hierarchy, RefineOptions, Refiner};

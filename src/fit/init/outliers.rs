@@ -52,6 +52,11 @@ pub const NOISE_FLOOR: Real = 1.5;
 /// See [`OFFSET_SIGMAS`].
 pub const OFFSET_SLACK: Real = 0.25;
 
+/// With Gaussian noise `σ` along the normal, a plane fitted to 8 points
+/// leaves `8 r² ~ σ² χ²₅` (3 of the 8 degrees of freedom go to the plane),
+/// and the median of `√(χ²₅ / 5)` is 0.933, so `σ ≈ median r · √(8/5) / 0.933`.
+pub const UNTRIMMED_TO_NOISE: Real = 1.355_9;
+
 /// Passes of the two tests: an outlier next to another one can tilt its
 /// neighbours' plane and survive the first pass, not the second.
 const PASSES: usize = 2;
@@ -63,11 +68,22 @@ const REPASS_FRACTION: Real = 0.005;
 /// True for the points to keep: up to two passes of the tests of the
 /// module docs, each on the points kept by the previous one.
 pub fn inlier_mask(points: &[Point3]) -> Vec<bool> {
+    inliers_and_noise(points).0
+}
+
+/// [`inlier_mask`] and the noise level of the first pass: the median over
+/// the cloud of the 8 neighbours' RMS offset `r` from their (untrimmed)
+/// least-squares plane, times [`UNTRIMMED_TO_NOISE`]; 0 when the cloud is too
+/// small or too degenerate to tell. Curvature within a neighbourhood adds
+/// to it, so on coarsely sampled curved surfaces it overestimates the noise.
+pub fn inliers_and_noise(points: &[Point3]) -> (Vec<bool>, Real) {
     let mut keep = vec![true; points.len()];
+    let mut noise = None;
     for _ in 0..PASSES {
         let index: Vec<usize> = (0..points.len()).filter(|&i| keep[i]).collect();
         let subset: Vec<Point3> = index.iter().map(|&i| points[i]).collect();
-        let pass = one_pass(&subset);
+        let (pass, sigma) = one_pass(&subset);
+        noise.get_or_insert(sigma);
         let dropped = pass.iter().filter(|&&k| !k).count();
         if dropped == 0 {
             break;
@@ -79,18 +95,20 @@ pub fn inlier_mask(points: &[Point3]) -> Vec<bool> {
             break;
         }
     }
-    keep
+    (keep, noise.unwrap_or(0.0))
 }
 
-/// One pass of the tests; clouds with at most `K + 1` points keep everything.
-fn one_pass(points: &[Point3]) -> Vec<bool> {
+/// One pass of the tests and `σ̃`; clouds with at most `K + 1` points keep
+/// everything.
+fn one_pass(points: &[Point3]) -> (Vec<bool>, Real) {
     if points.len() <= K + 1 {
-        return vec![true; points.len()];
+        return (vec![true; points.len()], 0.0);
     }
     let tree = point_tree(points);
     let k = NonZero::new(K + 1).unwrap_or(NonZero::<usize>::MIN);
-    // Per point: d_8, the offset from the plane of the 8 neighbours and their RMS offset σ.
-    let stats: Vec<(Real, Real, Real)> = points
+    // Per point: d_8, the offset from the plane of the 8 neighbours, their
+    // RMS offset σ (trimmed refit) and their RMS offset from the untrimmed fit.
+    let stats: Vec<(Real, Real, Real, Real)> = points
         .par_iter()
         .map(|p| {
             let near = tree.nearest_n::<SquaredEuclidean>(&[p.x, p.y, p.z], k);
@@ -100,8 +118,8 @@ fn one_pass(points: &[Point3]) -> Vec<bool> {
                 .skip(1)
                 .map(|nn| points[nn.item as usize].coords)
                 .collect();
-            let (offset, sigma) = plane_offset(&p.coords, &others);
-            (d8, offset, sigma)
+            let (offset, sigma, untrimmed) = plane_offset(&p.coords, &others);
+            (d8, offset, sigma, untrimmed)
         })
         .collect();
     let mut d8: Vec<Real> = stats.iter().map(|s| s.0).collect();
@@ -110,18 +128,22 @@ fn one_pass(points: &[Point3]) -> Vec<bool> {
     let m = d8[mid];
     if m <= 0.0 {
         // Mostly repeated points: no scale to judge by.
-        return vec![true; points.len()];
+        return (vec![true; points.len()], 0.0);
     }
-    let mut sigmas: Vec<Real> = stats.iter().map(|s| s.2).collect();
-    sigmas.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
-    let floor = NOISE_FLOOR * sigmas[mid];
-    stats
+    let median = |i: fn(&(Real, Real, Real, Real)) -> Real| {
+        let mut v: Vec<Real> = stats.iter().map(i).collect();
+        *v.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1
+    };
+    let floor = NOISE_FLOOR * median(|s| s.2);
+    let noise = median(|s| s.3) * UNTRIMMED_TO_NOISE;
+    let keep = stats
         .iter()
-        .map(|&(d, offset, sigma)| {
+        .map(|&(d, offset, sigma, _)| {
             d <= ISOLATION_FACTOR * m
                 && offset <= OFFSET_SIGMAS * sigma.max(floor) + OFFSET_SLACK * m
         })
-        .collect()
+        .collect();
+    (keep, noise)
 }
 
 /// Distance from `p` to the least-squares plane of `others` and the RMS
@@ -129,9 +151,9 @@ fn one_pass(points: &[Point3]) -> Vec<bool> {
 /// time without the [`TRIM`] neighbours furthest from the first plane, so
 /// other outliers next to `p` cannot tilt it. `(0, 0)` when the neighbours
 /// are (nearly) collinear and define no plane.
-fn plane_offset(p: &Vector3, others: &[Vector3]) -> (Real, Real) {
-    let Some((c, n, _)) = plane(others) else {
-        return (0.0, 0.0);
+fn plane_offset(p: &Vector3, others: &[Vector3]) -> (Real, Real, Real) {
+    let Some((c, n, untrimmed)) = plane(others) else {
+        return (0.0, 0.0, 0.0);
     };
     let mut by_residual: Vec<(Real, usize)> = others
         .iter()
@@ -144,8 +166,8 @@ fn plane_offset(p: &Vector3, others: &[Vector3]) -> (Real, Real) {
         .map(|&(_, i)| others[i])
         .collect();
     match plane(&rest) {
-        Some((c, n, sigma)) => ((p - c).dot(&n).abs(), sigma),
-        None => (0.0, 0.0),
+        Some((c, n, sigma)) => ((p - c).dot(&n).abs(), sigma, untrimmed),
+        None => (0.0, 0.0, untrimmed),
     }
 }
 

@@ -1,0 +1,60 @@
+//! Which control faces to refine: those whose data residual is above the
+//! noise (the test behind adaptive refinement in
+//! [`Refinement::Adaptive`](super::Refinement)).
+//!
+//! With Gaussian noise of deviation `σ` along the normal, the squared
+//! distances of a face's `n` points to a surface that has no bias there
+//! average `σ²` with standard error `σ² √(2/n)` (a `χ²ₙ/n` variable). A face
+//! is refined when its mean squared distance exceeds `σ̂² (1 + z √(2/n))`:
+//! the surface misses a shape the data show there, which a finer control
+//! mesh can follow. `σ̂ = median |d| / 0.6745` over every point with a
+//! non-zero robust weight (the median of a half-normal variable is
+//! `0.6745 σ`); where more than half of the points are fitted to within
+//! the noise this estimates the noise, otherwise it overestimates it and the
+//! test refines fewer faces, to be tested again at the next level.
+
+use crate::math::Real;
+
+/// Fewer points than this on a face give no evidence for refining it.
+pub const MIN_POINTS: usize = 4;
+
+/// The faces to refine and the noise estimate `σ̂` they were judged by.
+/// `face[i]` is the control face holding point `i`'s closest point, `dist[i]`
+/// its distance and `weight[i]` its robust weight (0 = outlier, not counted).
+pub fn faces_above_noise(
+    num_faces: usize,
+    face: &[u32],
+    dist: &[Real],
+    weight: &[Real],
+    data_noise: Real,
+    z: Real,
+) -> (Vec<bool>, Real) {
+    let mut inliers: Vec<Real> = dist
+        .iter()
+        .zip(weight)
+        .filter(|(d, w)| **w > 0.0 && d.is_finite())
+        .map(|(d, _)| *d)
+        .collect();
+    if inliers.is_empty() {
+        return (vec![false; num_faces], 0.0);
+    }
+    let mid = inliers.len() / 2;
+    let median = *inliers.select_nth_unstable_by(mid, Real::total_cmp).1;
+    let sigma = (median / 0.6745).min(data_noise);
+    let mut count = vec![0usize; num_faces];
+    let mut sum = vec![0.0; num_faces];
+    for ((&f, &d), &w) in face.iter().zip(dist).zip(weight) {
+        if w > 0.0 && d.is_finite() {
+            count[f as usize] += 1;
+            sum[f as usize] += d * d;
+        }
+    }
+    let marks = count
+        .iter()
+        .zip(&sum)
+        .map(|(&n, &s)| {
+            n >= MIN_POINTS && s / n as Real > sigma * sigma * (1.0 + z * (2.0 / n as Real).sqrt())
+        })
+        .collect();
+    (marks, sigma)
+}

@@ -1,0 +1,55 @@
+//! Control points whose limit points interpolate given targets, by
+//! progressive iterative approximation.
+//!
+//! With `L` the limit-position stencil of a control mesh's vertices
+//! ([`limit_stencil`]), the iteration `P ← P + (T − L P)` of Chen, Zhang,
+//! Luo and Wang (2008, "Progressive interpolation based on Catmull-Clark
+//! subdivision surfaces") drives every vertex's limit point to its target
+//! `T`; it converges because the eigenvalues of `L` lie in `(0, 1]` (each
+//! limit mask is a convex combination centred on its own vertex). The error
+//! left after `k` iterations is `(I − L)ᵏ (T − L P₀)`, so a good start needs
+//! few iterations.
+
+use crate::error::{Error, Result};
+use crate::math::{Point3, Real};
+use crate::mesh::PolyMesh;
+use crate::subdivision::{RefineOptions, Refiner};
+
+use super::limit_stencil;
+
+/// Moves `mesh`'s control points for `iterations` steps of progressive
+/// iterative approximation towards limit points `targets` (one per vertex)
+/// and returns them with the largest remaining distance `|T − L P|`.
+pub fn interpolate_limit_points(
+    mesh: &PolyMesh,
+    targets: &[Point3],
+    iterations: usize,
+) -> Result<(Vec<Point3>, Real)> {
+    if targets.len() != mesh.num_vertices() {
+        return Err(Error::Input(format!(
+            "{} limit targets for {} control points",
+            targets.len(),
+            mesh.num_vertices()
+        )));
+    }
+    let h = Refiner::new(mesh, &RefineOptions::default())?.refine_uniform(0)?;
+    let l = limit_stencil(&h, 0)?;
+    let mut p = mesh.positions.clone();
+    let mut lp = vec![Point3::origin(); p.len()];
+    let mut residual = 0.0;
+    for k in 0..=iterations {
+        l.apply_into(&p, &mut lp);
+        residual = targets
+            .iter()
+            .zip(&lp)
+            .map(|(t, y)| (t - y).norm())
+            .fold(0.0, Real::max);
+        if k == iterations {
+            break;
+        }
+        for ((x, t), y) in p.iter_mut().zip(targets).zip(&lp) {
+            x.coords += t.coords - y.coords;
+        }
+    }
+    Ok((p, residual))
+}
