@@ -12,9 +12,9 @@
 //! `½ Σ k |x − d|² + ½ pᵀ K p` decreases monotonically (with fixed robust
 //! weights). When it settles (relative change below the tolerance) the error
 //! is measured; above the tolerance the control mesh is subdivided and the
-//! fit goes on. Uniform refinement splits every face (the new control points
-//! `S p` describe the same surface). Adaptive refinement (the default)
-//! splits only the faces whose data residual is above the noise
+//! fit goes on. Uniform refinement (the default) splits every face (the new
+//! control points `S p` describe the same surface). Adaptive refinement
+//! (experimental) splits only the faces whose data residual is above the noise
 //! ([`super::refine_marks`], [`crate::subdivision::refine_marked`]) and puts
 //! the new control mesh's limit points on the parent's surface by
 //! progressive interpolation; should such a level fit worse than its parent
@@ -46,7 +46,7 @@ use crate::limit::{
 };
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
-use crate::subdivision::{RefineOptions, Refiner, close_marks, refine_marked};
+use crate::subdivision::{CornerImage, RefineOptions, Refiner, close_marks, refine_marked};
 use crate::topology::face_of_corner;
 
 use super::init::outliers::inliers_and_noise;
@@ -57,6 +57,17 @@ use super::{ErrorStats, FitParams, FitReport, LevelReport, Refinement};
 /// Iterations of progressive interpolation that put a locally refined
 /// level's surface on its parent's.
 const LIMIT_ITERATIONS: usize = 60;
+
+/// A previous level's closest point carried to the next level.
+enum Carried {
+    /// At `(s, t)` of this base face of the new control mesh (located on
+    /// its patches once they are built).
+    Face(u32, [Real; 2]),
+    /// At `(s, t)` of this patch of the new control mesh.
+    Patch(u32, [Real; 2]),
+    /// Not carried: its face changed shape.
+    None,
+}
 
 /// A fitted model and what it took.
 #[derive(Clone, Debug)]
@@ -114,7 +125,9 @@ pub fn fit_point_cloud(
         .collect();
     let shuffled: Vec<Point3> = order.iter().map(|&i| points[i]).collect();
     let n_all = points.len() as Real;
-    let mut carried_hints: Option<Vec<(u32, [Real; 2])>> = None;
+    // The previous level's closest points in this level's terms (see
+    // `Carried`).
+    let mut carried_hints: Option<Vec<Carried>> = None;
     let mut refinement = String::from("initial");
     // The parent of an adaptive level, kept to refine it uniformly instead
     // should the adaptive level fit worse.
@@ -178,14 +191,17 @@ pub fn fit_point_cloud(
             (Vec::new(), Vec::new(), Vec::new());
         let mut cg_iterations = 0;
         let mut steps = 0;
-        // The previous level's answers, in this level's patches: its patch
-        // `f` is this level's base face `f` (one uniform refinement apart),
-        // with the same corner frame.
+        // The previous level's answers, in this level's patches.
         let mut hints: Option<Vec<(u32, [Real; 2])>> = carried_hints.take().map(|h| {
             h.iter()
-                .map(|&(f, st)| {
-                    let (g, st) = engine.table().locate(f as usize, st[0], st[1]);
-                    (g as u32, st)
+                .map(|c| match *c {
+                    Carried::Face(f, st) => {
+                        let (g, st) = engine.table().locate(f as usize, st[0], st[1]);
+                        (g as u32, st)
+                    }
+                    Carried::Patch(g, st) => (g, st),
+                    // Out of range: a full search.
+                    Carried::None => (u32::MAX, [0.5; 2]),
                 })
                 .collect()
         });
@@ -361,6 +377,7 @@ pub fn fit_point_cloud(
                 "uniform, after an adaptive level ({} control points) that fitted worse than its parent (95th percentile {:.3} % against {:.3} %)",
                 report.control_points, report.error.p95_pct, before.error.p95_pct
             );
+            carried_hints = None;
             let h = Refiner::new(&parent, &RefineOptions::default())?.refine_uniform(1)?;
             let p1 = h.stencil(0).apply(&parent.positions)?;
             mesh = h.mesh(1, p1);
@@ -396,6 +413,14 @@ pub fn fit_point_cloud(
         let next = match params.refinement {
             Refinement::Uniform => {
                 refinement = "uniform".into();
+                // Patch `f` is the refined mesh's base face `f` (one uniform
+                // refinement apart), with the same corner frame.
+                carried_hints = Some(
+                    last_hints
+                        .iter()
+                        .map(|&(f, st)| Carried::Face(f, st))
+                        .collect(),
+                );
                 let p1 = h.stencil(0).apply(&mesh.positions)?;
                 h.mesh(1, p1)
             }
@@ -433,6 +458,18 @@ pub fn fit_point_cloud(
                     marks.len()
                 );
                 adaptive_parent = Some(mesh.clone());
+                carried_hints = Some(
+                    last_hints
+                        .iter()
+                        .map(|&(p, st)| match local.corner_image[p as usize] {
+                            CornerImage::Face(g) => Carried::Face(g, st),
+                            CornerImage::Corner(g, i) => {
+                                Carried::Patch(local.mesh.face_offsets[g as usize] + i, st)
+                            }
+                            CornerImage::Changed => Carried::None,
+                        })
+                        .collect(),
+                );
                 PolyMesh {
                     positions: p,
                     ..local.mesh
@@ -451,9 +488,7 @@ pub fn fit_point_cloud(
                 ),
             );
         }
-        if params.refinement == Refinement::Uniform {
-            carried_hints = Some(last_hints);
-        }
+
         mesh = next;
     };
     Ok(FitResult {

@@ -242,14 +242,18 @@ impl ClosestPointEngine {
     }
 
     /// Closest points of many queries, each also started from its hint (see
-    /// [`closest_point_near`](Self::closest_point_near)), in parallel.
+    /// [`closest_point_near`](Self::closest_point_near)), in parallel. A hint
+    /// whose patch is out of range counts as none: a full search.
     pub fn closest_points_near(
         &self,
         queries: &[Point3],
         hints: &[(u32, [Real; 2])],
     ) -> Result<Vec<ClosestPoint>> {
         self.seed_tree()?;
-        self.each_with_start(queries, hints, |q, h| self.closest_point_near(q, Some(h)))
+        let n = self.table.num_patches();
+        self.each_with_start(queries, hints, |q, h| {
+            self.closest_point_near(q, Some(h).filter(|h| (h.0 as usize) < n))
+        })
     }
 
     /// [`closest_point_local`](Self::closest_point_local) for many queries,

@@ -39,6 +39,22 @@ pub struct LocalRefinement {
     /// The vertex of one uniform refinement step that every child vertex
     /// stands for (its row in the uniform stencil).
     pub uniform_vertex: Vec<u32>,
+    /// Where each parent corner's level-1 sub-face (corner `i` of face `f`,
+    /// index `face_offsets[f] + i`) lies in the child mesh.
+    pub corner_image: Vec<CornerImage>,
+}
+
+/// The child-mesh image of a parent's level-1 sub-face.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CornerImage {
+    /// The whole child face (a split face's quad at that corner), with the
+    /// same corner frame.
+    Face(u32),
+    /// The same level-1 sub-face of a child face that kept the parent's
+    /// corners: child face, corner.
+    Corner(u32, u32),
+    /// The sub-face of a face that gained corners: its shape changed.
+    Changed,
 }
 
 /// The marks extended until no unmarked face has at least half of its edges
@@ -137,6 +153,7 @@ pub fn refine_marked(
     }
     let mut faces: Vec<Vec<u32>> = Vec::with_capacity(nf + 3 * marked.len());
     let mut parent_face = Vec::with_capacity(faces.capacity());
+    let mut corner_image = Vec::with_capacity(level.face_verts.len());
     for f in 0..nf {
         let fv = level.face_vertices(f);
         let fe = level.face_edge_list(f);
@@ -144,6 +161,7 @@ pub fn refine_marked(
         if marked[f] {
             for i in 0..n {
                 let (e_i, e_p) = (fe[i] as usize, fe[(i + n - 1) % n] as usize);
+                corner_image.push(CornerImage::Face(faces.len() as u32));
                 faces.push(vec![fv[i], edge_point[e_i], face_point[f], edge_point[e_p]]);
                 parent_face.push(f as u32);
             }
@@ -155,6 +173,14 @@ pub fn refine_marked(
                     face.push(edge_point[fe[i] as usize]);
                 }
             }
+            let g = faces.len() as u32;
+            corner_image.extend((0..n as u32).map(|i| {
+                if face.len() == n {
+                    CornerImage::Corner(g, i)
+                } else {
+                    CornerImage::Changed
+                }
+            }));
             faces.push(face);
             parent_face.push(f as u32);
         }
@@ -165,5 +191,6 @@ pub fn refine_marked(
         stencil,
         parent_face,
         uniform_vertex,
+        corner_image,
     })
 }

@@ -16,7 +16,7 @@ pub use doo_sabin::{
     DooSabinHierarchy, DooSabinStep, doo_sabin_faces, doo_sabin_refine, doo_sabin_step,
     doo_sabin_weight,
 };
-pub use local_refine::{LocalRefinement, close_marks, refine_marked};
+pub use local_refine::{CornerImage, LocalRefinement, close_marks, refine_marked};
 pub use non_uniform::{NonUniformHierarchy, check_intervals, non_uniform_step};
 pub use refine_topology::refine_topology;
 pub use refiner::{BoundaryRule, Hierarchy, RefineOptions, Refiner};
