@@ -451,7 +451,18 @@ pub fn fit_point_cloud(
                     .iter()
                     .map(|&u| parent_limit[u as usize])
                     .collect();
-                let (p, _) = interpolate_limit_points(&local.mesh, &targets, LIMIT_ITERATIONS)?;
+                // Only the vertices of split or changed faces move.
+                let mut movable = vec![false; local.mesh.num_vertices()];
+                for (g, &f) in local.parent_face.iter().enumerate() {
+                    let face = local.mesh.face(g);
+                    if face != mesh.face(f as usize) {
+                        for &v in face {
+                            movable[v as usize] = true;
+                        }
+                    }
+                }
+                let (p, _) =
+                    interpolate_limit_points(&local.mesh, &targets, &movable, LIMIT_ITERATIONS)?;
                 refinement = format!(
                     "adaptive: {} of {} faces split",
                     marks.iter().filter(|&&m| m).count(),

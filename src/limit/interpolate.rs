@@ -17,18 +17,23 @@ use crate::subdivision::{RefineOptions, Refiner};
 
 use super::limit_stencil;
 
-/// Moves `mesh`'s control points for `iterations` steps of progressive
-/// iterative approximation towards limit points `targets` (one per vertex)
-/// and returns them with the largest remaining distance `|T − L P|`.
+/// Moves the `movable` control points of `mesh` for `iterations` steps of
+/// progressive iterative approximation towards limit points `targets` (one
+/// per vertex) and returns all of them with the largest remaining distance
+/// `|T − L P|` over the movable ones. Keeping the others fixed (the
+/// iteration on a principal submatrix of `L`, which converges likewise)
+/// stops a local change from rippling over the whole mesh.
 pub fn interpolate_limit_points(
     mesh: &PolyMesh,
     targets: &[Point3],
+    movable: &[bool],
     iterations: usize,
 ) -> Result<(Vec<Point3>, Real)> {
-    if targets.len() != mesh.num_vertices() {
+    if targets.len() != mesh.num_vertices() || movable.len() != mesh.num_vertices() {
         return Err(Error::Input(format!(
-            "{} limit targets for {} control points",
+            "{} limit targets and {} movable flags for {} control points",
             targets.len(),
+            movable.len(),
             mesh.num_vertices()
         )));
     }
@@ -42,12 +47,20 @@ pub fn interpolate_limit_points(
         residual = targets
             .iter()
             .zip(&lp)
-            .map(|(t, y)| (t - y).norm())
+            .zip(movable)
+            .filter(|(_, m)| **m)
+            .map(|((t, y), _)| (t - y).norm())
             .fold(0.0, Real::max);
         if k == iterations {
             break;
         }
-        for ((x, t), y) in p.iter_mut().zip(targets).zip(&lp) {
+        for (((x, t), y), _) in p
+            .iter_mut()
+            .zip(targets)
+            .zip(&lp)
+            .zip(movable)
+            .filter(|(_, m)| **m)
+        {
             x.coords += t.coords - y.coords;
         }
     }
