@@ -287,6 +287,32 @@ fn regular_patches_agree_with_brute_force_quadrature() {
     assert!(worst(&k, &kb) < 1e-10, "K differs by {:e}", worst(&k, &kb));
 }
 
+/// The cube refined twice, perturbed.
+fn refined_cube() -> PolyMesh {
+    let mut mesh = subdyn::examples::cube();
+    for _ in 0..2 {
+        let h = default_refiner(&mesh).refine_uniform(1).unwrap();
+        let p = h.stencil(0).apply(&mesh.positions).unwrap();
+        mesh = h.mesh(1, p);
+    }
+    let mut seed = 3;
+    for p in &mut mesh.positions {
+        p.x += 0.02 * lcg(&mut seed);
+        p.y += 0.02 * lcg(&mut seed);
+    }
+    mesh
+}
+
+/// [`refined_cube`] with every fifth face split locally.
+fn locally_refined_cube() -> PolyMesh {
+    let mesh = refined_cube();
+    let h = default_refiner(&mesh).refine_uniform(1).unwrap();
+    let marks: Vec<bool> = (0..mesh.num_faces()).map(|f| f % 5 == 0).collect();
+    subdyn::subdivision::refine_marked(&mesh, h.level(0), h.stencil(0), &marks)
+        .unwrap()
+        .mesh
+}
+
 /// The patch-by-patch element assembly gives the same matrices as the Gram
 /// matrices of the sample rows at the same points: on regular patches the
 /// exact ones of `quadrature`, at irregular vertices, boundaries and n-gons
@@ -299,6 +325,12 @@ fn element_assembly_matches_sample_gram_matrices() {
         (subdyn::examples::cube(), false),
         (reference_mesh("fan5_open"), false),
         (reference_mesh("grid4_open"), false),
+        // Irregular patches of one structure many times over (their
+        // elements are computed once and reordered): the eight corners of
+        // a refined cube, and the T-vertices and pentagons of a locally
+        // refined one.
+        (refined_cube(), false),
+        (locally_refined_cube(), false),
     ] {
         let r = default_refiner(&mesh);
         let table = PatchTable::new(&r, &mesh.positions, 1).unwrap();

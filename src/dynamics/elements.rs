@@ -19,6 +19,8 @@
 //! [`super::stiffness_matrix`] of [`super::quadrature`] to round-off
 //! (`tests/dynamics.rs`).
 
+use std::collections::HashMap;
+
 use rayon::prelude::*;
 
 use super::gauss_legendre;
@@ -140,8 +142,8 @@ fn elements<const N: usize>(
     let gl = gauss_legendre(order);
     Ok((0..table.num_patches())
         .into_par_iter()
-        .map_init(Vec::new, |frames, f| {
-            patch_element(table, f, &gl, c, frames)
+        .map_init(Caches::default, |caches, f| {
+            patch_element(table, f, &gl, c, caches)
         })
         .collect())
 }
@@ -165,8 +167,28 @@ fn scattered<const N: usize>(
         .unwrap_or_else(|_| unreachable!("one matrix per weight set")))
 }
 
-/// The regular patches' `16 × 16` grid matrices by frame (one per weight set).
-type FrameCache<const N: usize> = Vec<([[Real; 2]; 2], [Vec<Real>; N])>;
+/// Per-thread element caches: the regular patches' `16 × 16` grid matrices
+/// by frame, and the irregular patches' matrices over their quadtree
+/// columns by local structure and frame (one matrix per weight set).
+struct Caches<const N: usize> {
+    frames: Vec<([[Real; 2]; 2], Matrices<N>)>,
+    shapes: HashMap<ShapeKey, Matrices<N>>,
+}
+
+/// One row-major matrix per weight set.
+type Matrices<const N: usize> = [Vec<Real>; N];
+
+/// An irregular patch's local structure and the bits of its frame.
+type ShapeKey = (Vec<u64>, [u64; 4]);
+
+impl<const N: usize> Default for Caches<N> {
+    fn default() -> Self {
+        Caches {
+            frames: Vec::new(),
+            shapes: HashMap::new(),
+        }
+    }
+}
 
 /// Inverse of a 2 × 2 matrix and its |determinant|.
 fn inverse(m: [[Real; 2]; 2]) -> ([[Real; 2]; 2], Real) {
@@ -211,52 +233,23 @@ fn add_outer_one<'a>(
 }
 
 /// The element of patch `f` over the level-`L` vertices (columns and
-/// row-major matrix). `frames` caches
-/// the grid matrices of the frames seen so far (per thread).
+/// row-major matrix). `caches` keeps the matrices of the frames and
+/// irregular structures seen so far (per thread).
 fn patch_element<const N: usize>(
     table: &PatchTable,
     f: usize,
     gl: &[(Real, Real)],
     c: [[Real; 6]; N],
-    frames: &mut FrameCache<N>,
+    caches: &mut Caches<N>,
 ) -> PatchElement<N> {
     let (_, axes) = table.patch_frame(f);
     let (inv, det) = inverse(axes);
     let Some(grid) = table.grid_rows(f) else {
-        // Irregular: exact stencils at the Gauss points of the whole patch.
-        let mut cols: Vec<u32> = Vec::new();
-        let (sts, ws): (Vec<[Real; 2]>, Vec<Real>) = gl
-            .iter()
-            .flat_map(|&(a, wa)| gl.iter().map(move |&(b, wb)| ([a, b], wa * wb)))
-            .unzip();
-        let samples: Vec<(SampleStencil, Real)> = table
-            .stencils(f, &sts)
-            .into_iter()
-            .zip(ws)
-            .map(|(mut s, w)| {
-                rows_to_base(&mut s.weights, inv);
-                cols.extend_from_slice(&s.cols);
-                (s, w * det)
-            })
-            .collect();
-        cols.sort_unstable();
-        cols.dedup();
-        let m = cols.len();
-        let mut matrix = [(); N].map(|_| vec![0.0; m * m]);
-        let mut dense = [(); 6].map(|_| vec![0.0; m]);
-        for (s, w) in &samples {
-            for (q, d) in dense.iter_mut().enumerate() {
-                d.iter_mut().for_each(|x| *x = 0.0);
-                for (&col, &x) in s.cols.iter().zip(&s.weights[q]) {
-                    d[cols.binary_search(&col).unwrap_or(0)] += x;
-                }
-            }
-            add_outer(&mut matrix, m, c, *w, |q| &dense[q]);
-        }
-        return (cols, matrix);
+        return irregular_element(table, f, gl, c, (inv, det), caches);
     };
     // Regular: the frame's 16 × 16 grid matrix, carried by the grid rows G
     // (a selection for interior patches) as Gᵀ E G.
+    let frames = &mut caches.frames;
     let e = match frames.iter().position(|(a, _)| *a == axes) {
         Some(i) => &frames[i].1,
         None => {
@@ -283,6 +276,102 @@ fn patch_element<const N: usize>(
         }
     }
     (cols, std::array::from_fn(|i| carried(&e[i], &g, m)))
+}
+
+/// The element of irregular patch `f` (frame `inv`, `det`): the exact
+/// stencils at the Gauss points of the whole patch. Patches with the same
+/// local structure and frame have the same stencils over their quadtree
+/// columns, so the matrix is computed once per structure (per thread) and
+/// reordered to each patch's sorted columns.
+fn irregular_element<const N: usize>(
+    table: &PatchTable,
+    f: usize,
+    gl: &[(Real, Real)],
+    c: [[Real; 6]; N],
+    (inv, det): ([[Real; 2]; 2], Real),
+    caches: &mut Caches<N>,
+) -> PatchElement<N> {
+    let shape = table.irregular_shape(f);
+    let frame = [inv[0][0], inv[0][1], inv[1][0], inv[1][1]].map(Real::to_bits);
+    if let Some((local, key)) = &shape
+        && let Some(matrix) = caches.shapes.get(&(key.clone(), frame))
+    {
+        return sorted_element(local, matrix);
+    }
+    let (sts, ws): (Vec<[Real; 2]>, Vec<Real>) = gl
+        .iter()
+        .flat_map(|&(a, wa)| gl.iter().map(move |&(b, wb)| ([a, b], wa * wb)))
+        .unzip();
+    let samples: Vec<(SampleStencil, Real)> = table
+        .stencils(f, &sts)
+        .into_iter()
+        .zip(ws)
+        .map(|(mut s, w)| {
+            rows_to_base(&mut s.weights, inv);
+            (s, w * det)
+        })
+        .collect();
+    // The quadtree's columns when every stencil lies on them (exact
+    // evaluations in the innermost cells do too), else their sorted union.
+    let local = shape.as_ref().map(|(local, _)| local).filter(|local| {
+        samples
+            .iter()
+            .all(|(s, _)| s.cols.iter().all(|c| local.contains(c)))
+    });
+    let cols: Vec<u32> = match local {
+        Some(local) => local.clone(),
+        None => {
+            let mut cols: Vec<u32> = samples.iter().flat_map(|(s, _)| s.cols.clone()).collect();
+            cols.sort_unstable();
+            cols.dedup();
+            cols
+        }
+    };
+    let mut position: Vec<(u32, usize)> = cols.iter().copied().zip(0..).collect();
+    position.sort_unstable();
+    let at = |col: u32| {
+        position
+            .binary_search_by_key(&col, |p| p.0)
+            .map_or(0, |i| position[i].1)
+    };
+    let m = cols.len();
+    let mut matrix = [(); N].map(|_| vec![0.0; m * m]);
+    let mut dense = [(); 6].map(|_| vec![0.0; m]);
+    for (s, w) in &samples {
+        for (q, d) in dense.iter_mut().enumerate() {
+            d.iter_mut().for_each(|x| *x = 0.0);
+            for (&col, &x) in s.cols.iter().zip(&s.weights[q]) {
+                d[at(col)] += x;
+            }
+        }
+        add_outer(&mut matrix, m, c, *w, |q| &dense[q]);
+    }
+    match (local.is_some(), shape) {
+        (true, Some((local, key))) => {
+            let element = sorted_element(&local, &matrix);
+            caches.shapes.insert((key, frame), matrix);
+            element
+        }
+        _ => (cols, matrix),
+    }
+}
+
+/// Columns `cols` sorted, with each row-major `m × m` matrix over them
+/// reordered to match.
+fn sorted_element<const N: usize>(cols: &[u32], matrices: &[Vec<Real>; N]) -> PatchElement<N> {
+    let m = cols.len();
+    let mut order: Vec<usize> = (0..m).collect();
+    order.sort_unstable_by_key(|&i| cols[i]);
+    let sorted = order.iter().map(|&i| cols[i]).collect();
+    let reordered = std::array::from_fn(|k| {
+        let a = &matrices[k];
+        let mut out = Vec::with_capacity(m * m);
+        for &i in &order {
+            out.extend(order.iter().map(|&j| a[i * m + j]));
+        }
+        out
+    });
+    (sorted, reordered)
 }
 
 /// `Gᵀ E G` for the `16 × 16` grid matrix `E` and the `16 × m` grid rows `G`.

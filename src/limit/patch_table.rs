@@ -397,6 +397,21 @@ impl PatchTable {
         &self.to_level
     }
 
+    /// For a patch at an irregular vertex: the level-`L` vertices its
+    /// stencils use, in the order of its quadtree (the columns of
+    /// [`stencils`](Self::stencils) wherever the quadtree answers), and the
+    /// key of its local structure (topology, sharpness, face followed).
+    /// Patches with equal keys have the same stencils at the same `(s, t)`
+    /// up to that column order. `None` for a regular patch.
+    pub fn irregular_shape(&self, f: usize) -> Option<(Vec<u32>, Vec<u64>)> {
+        if self.patches[f].regular {
+            return None;
+        }
+        let root = LocalPatch::around(&self.level, &self.sharp, f);
+        let key = root.shape_key();
+        Some((root.cols, key))
+    }
+
     /// The 16 bicubic B-spline control points of patch `f` as rows over the
     /// level-`L` vertices (phantom points at boundaries and creases are
     /// combinations), row `k` for weight `k` of
