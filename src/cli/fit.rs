@@ -36,11 +36,11 @@ pub enum TolStat {
 /// How a level above the tolerance is refined.
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum RefineMode {
+    /// Split only the faces whose data residual is above the noise (fewer
+    /// control points, slower).
+    Adaptive,
     /// Split every face (the paper's scheme).
     Uniform,
-    /// Split only the faces whose data residual is above the noise
-    /// (experimental: fewer control points, slower).
-    Adaptive,
 }
 
 /// Arguments of `subdyn fit`.
@@ -69,7 +69,7 @@ pub struct FitArgs {
     #[arg(long, value_name = "L", default_value_t = 3)]
     pub max_level: usize,
     /// How a level that settled above the tolerance is refined.
-    #[arg(long, value_enum, default_value_t = RefineMode::Uniform)]
+    #[arg(long, value_enum, default_value_t = RefineMode::Adaptive)]
     pub refine: RefineMode,
     /// Adaptive refinement splits a face when its mean squared data distance
     /// exceeds the noise variance by Z standard errors; lower splits more.

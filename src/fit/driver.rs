@@ -12,9 +12,9 @@
 //! `½ Σ k |x − d|² + ½ pᵀ K p` decreases monotonically (with fixed robust
 //! weights). When it settles (relative change below the tolerance) the error
 //! is measured; above the tolerance the control mesh is subdivided and the
-//! fit goes on. Uniform refinement (the default) splits every face (the new
-//! control points `S p` describe the same surface). Adaptive refinement
-//! (experimental) splits only the faces whose data residual is above the noise
+//! fit goes on. Uniform refinement splits every face (the new control points
+//! `S p` describe the same surface). Adaptive refinement (the default)
+//! splits only the faces whose data residual is above the noise
 //! ([`super::refine_marks`], [`crate::subdivision::refine_marked`]) and puts
 //! the new control mesh's limit points on the parent's surface by
 //! progressive interpolation; should such a level fit worse than its parent
@@ -425,11 +425,17 @@ pub fn fit_point_cloud(
                 h.mesh(1, p1)
             }
             Refinement::Adaptive => {
+                // The points left out of the springs do not count either.
+                let counted: Vec<Real> = w
+                    .iter()
+                    .zip(&keep)
+                    .map(|(&w, &k)| if k { w } else { 0.0 })
+                    .collect();
                 let (marks, _) = faces_above_noise(
                     mesh.num_faces(),
                     &face,
                     &dist,
-                    &w,
+                    &counted,
                     data_noise,
                     params.refine_significance,
                 );
