@@ -46,7 +46,9 @@ use crate::limit::{
 };
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
-use crate::subdivision::{CornerImage, RefineOptions, Refiner, close_marks, refine_marked};
+use crate::subdivision::{
+    CornerImage, Hierarchy, LocalRefinement, RefineOptions, Refiner, close_marks, refine_marked,
+};
 use crate::topology::face_of_corner;
 
 use super::init::outliers::inliers_and_noise;
@@ -379,6 +381,17 @@ pub fn fit_point_cloud(
             );
             carried_hints = None;
             let h = Refiner::new(&parent, &RefineOptions::default())?.refine_uniform(1)?;
+            if h.level(1).num_vertices as Real > params.max_control_fraction * n_all {
+                mesh = parent;
+                break (
+                    false,
+                    format!(
+                        "level {level} fitted worse than its parent and a uniform one would have more than {} × the {} data points",
+                        params.max_control_fraction,
+                        points.len()
+                    ),
+                );
+            }
             let p1 = h.stencil(0).apply(&parent.positions)?;
             mesh = h.mesh(1, p1);
             continue;
@@ -448,27 +461,7 @@ pub fn fit_point_cloud(
                     );
                 }
                 let marks = close_marks(h.level(0), &marks);
-                let local = refine_marked(&mesh, h.level(0), h.stencil(0), &marks)?;
-                // Start from the parent's surface: every child vertex's limit
-                // point on the parent's limit point it stands for.
-                let parent_limit = limit_stencil(&h, 1)?.apply(&mesh.positions)?;
-                let targets: Vec<Point3> = local
-                    .uniform_vertex
-                    .iter()
-                    .map(|&u| parent_limit[u as usize])
-                    .collect();
-                // Only the vertices of split or changed faces move.
-                let mut movable = vec![false; local.mesh.num_vertices()];
-                for (g, &f) in local.parent_face.iter().enumerate() {
-                    let face = local.mesh.face(g);
-                    if face != mesh.face(f as usize) {
-                        for &v in face {
-                            movable[v as usize] = true;
-                        }
-                    }
-                }
-                let (p, _) =
-                    interpolate_limit_points(&local.mesh, &targets, &movable, LIMIT_ITERATIONS)?;
+                let local = locally_refined(&mesh, &h, &marks)?;
                 refinement = format!(
                     "adaptive: {} of {} faces split",
                     marks.iter().filter(|&&m| m).count(),
@@ -487,10 +480,7 @@ pub fn fit_point_cloud(
                         })
                         .collect(),
                 );
-                PolyMesh {
-                    positions: p,
-                    ..local.mesh
-                }
+                local.mesh
             }
         };
         if next.num_vertices() as Real > params.max_control_fraction * n_all {
@@ -505,7 +495,6 @@ pub fn fit_point_cloud(
                 ),
             );
         }
-
         mesh = next;
     };
     Ok(FitResult {
@@ -520,4 +509,32 @@ pub fn fit_point_cloud(
             seconds: start.elapsed().as_secs_f64(),
         },
     })
+}
+
+/// `mesh` with its `marked` faces split ([`refine_marked`]; `h` is one
+/// uniform refinement of it), the new control points placed so that the
+/// limit point of every vertex of a split or changed face lies on `mesh`'s
+/// limit surface where the vertex it stands for in uniform refinement has
+/// its limit point ([`interpolate_limit_points`]; the other vertices keep
+/// their positions, so the surface away from the split faces is unchanged).
+fn locally_refined(mesh: &PolyMesh, h: &Hierarchy, marked: &[bool]) -> Result<LocalRefinement> {
+    let mut local = refine_marked(mesh, h.level(0), h.stencil(0), marked)?;
+    let parent_limit = limit_stencil(h, 1)?.apply(&mesh.positions)?;
+    let targets: Vec<Point3> = local
+        .uniform_vertex
+        .iter()
+        .map(|&u| parent_limit[u as usize])
+        .collect();
+    let mut movable = vec![false; local.mesh.num_vertices()];
+    for (g, &f) in local.parent_face.iter().enumerate() {
+        let face = local.mesh.face(g);
+        if face != mesh.face(f as usize) {
+            for &v in face {
+                movable[v as usize] = true;
+            }
+        }
+    }
+    (local.mesh.positions, _) =
+        interpolate_limit_points(&local.mesh, &targets, &movable, LIMIT_ITERATIONS)?;
+    Ok(local)
 }

@@ -100,7 +100,10 @@ pub struct LevelReport {
     pub points_used: usize,
     /// Distances from all data points to the surface at the end of the level.
     pub error: ErrorStats,
-    /// Fraction of data points whose robust weight is zero (rejected outliers).
+    /// Fraction of data points whose robust weight is zero (rejected
+    /// outliers; always 0 with Huber's kernel, the default, which rejects
+    /// none: the outliers it would see are left out before the fit, see
+    /// [`FitReport::outliers`]).
     pub rejected: Real,
     /// How this level came from the previous one: `initial`, `uniform`,
     /// `adaptive: F of N faces split`, or `uniform, after an adaptive level
