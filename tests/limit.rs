@@ -1102,3 +1102,54 @@ fn level_one_patches_are_the_refined_meshs_faces() {
         }
     }
 }
+
+/// A hint on the wrong side of the surface does not trap the search: the
+/// nearest seed is closer than where the descent from the hint ends, so it
+/// is descended from too, and the answer is the unhinted one. A hint at the
+/// answer itself gives the same answer, and an out-of-range hint counts as
+/// none.
+#[test]
+fn closest_point_near_recovers_from_a_hint_on_the_far_side() {
+    let mesh = subdyn::examples::cube();
+    let r = default_refiner(&mesh);
+    let engine =
+        ClosestPointEngine::new(&r, &mesh.positions, &ClosestPointParams::default()).unwrap();
+    let centre = Point3::from(
+        mesh.positions.iter().map(|p| p.coords).sum::<Vector3>() / mesh.positions.len() as f64,
+    );
+    let mut rng = Rng::new(7);
+    let queries: Vec<Point3> = (0..50)
+        .map(|_| {
+            let d = Vector3::new(
+                rng.uniform(-1.0, 1.0),
+                rng.uniform(-1.0, 1.0),
+                rng.uniform(-1.0, 1.0),
+            );
+            centre + 3.0 * d.normalize()
+        })
+        .collect();
+    let plain = engine.closest_points(&queries).unwrap();
+    // The far side: the answer of the query mirrored through the centre.
+    let mirrored: Vec<Point3> = queries.iter().map(|q| centre - (q - centre)).collect();
+    let far: Vec<(u32, [f64; 2])> = engine
+        .closest_points(&mirrored)
+        .unwrap()
+        .iter()
+        .map(|c| c.patch)
+        .collect();
+    let own: Vec<(u32, [f64; 2])> = plain.iter().map(|c| c.patch).collect();
+    let out_of_range = vec![(u32::MAX, [0.5, 0.5]); queries.len()];
+    for hints in [&far, &own, &out_of_range] {
+        let hinted = engine.closest_points_near(&queries, hints).unwrap();
+        for ((q, a), b) in queries.iter().zip(&plain).zip(&hinted) {
+            assert!(
+                (a.distance - b.distance).abs() < 1e-9 && (a.point - b.point).norm() < 1e-6,
+                "{q}: unhinted {} at {}, hinted {} at {}",
+                a.distance,
+                a.point,
+                b.distance,
+                b.point
+            );
+        }
+    }
+}

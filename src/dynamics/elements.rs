@@ -128,7 +128,10 @@ fn assembled<const N: usize>(
     scattered(table, &elements(table, order, c)?)
 }
 
-/// Every patch's element for each set of weights `c`.
+/// Every patch's element for each set of weights `c`. Irregular patches
+/// with the same local structure and frame share one computation: their
+/// keys are found first, one patch of each distinct key is integrated, and
+/// every patch then takes its key's matrices reordered to its columns.
 fn elements<const N: usize>(
     table: &PatchTable,
     order: usize,
@@ -140,10 +143,43 @@ fn elements<const N: usize>(
         )));
     }
     let gl = gauss_legendre(order);
+    let shapes: Vec<Option<(Vec<u32>, ShapeKey)>> = (0..table.num_patches())
+        .into_par_iter()
+        .map(|f| {
+            table
+                .irregular_shape(f)
+                .map(|(local, key)| (local, (key, frame_bits(frame(table, f).0))))
+        })
+        .collect();
+    let mut first: HashMap<&ShapeKey, usize> = HashMap::new();
+    for (f, shape) in shapes.iter().enumerate() {
+        if let Some((_, key)) = shape {
+            first.entry(key).or_insert(f);
+        }
+    }
+    let first: Vec<(&ShapeKey, usize)> = first.into_iter().collect();
+    // A structure's matrices over its quadtree columns, or `None` when its
+    // stencils leave those columns (then every such patch is integrated on
+    // its own).
+    let shared: HashMap<&ShapeKey, Option<Matrices<N>>> = first
+        .par_iter()
+        .map(|&(key, f)| {
+            let local = shapes[f].as_ref().map(|(local, _)| &local[..]);
+            let (_, matrices, on_local) = irregular_element(table, f, &gl, c, local);
+            (key, on_local.then_some(matrices))
+        })
+        .collect();
     Ok((0..table.num_patches())
         .into_par_iter()
-        .map_init(Caches::default, |caches, f| {
-            patch_element(table, f, &gl, c, caches)
+        .map_init(Vec::new, |frames, f| match &shapes[f] {
+            None => regular_element(table, f, &gl, c, frames),
+            Some((local, key)) => match &shared[key] {
+                Some(matrices) => sorted_element(local, matrices),
+                None => {
+                    let (cols, matrices, _) = irregular_element(table, f, &gl, c, None);
+                    (cols, matrices)
+                }
+            },
         })
         .collect())
 }
@@ -167,13 +203,8 @@ fn scattered<const N: usize>(
         .unwrap_or_else(|_| unreachable!("one matrix per weight set")))
 }
 
-/// Per-thread element caches: the regular patches' `16 × 16` grid matrices
-/// by frame, and the irregular patches' matrices over their quadtree
-/// columns by local structure and frame (one matrix per weight set).
-struct Caches<const N: usize> {
-    frames: Vec<([[Real; 2]; 2], Matrices<N>)>,
-    shapes: HashMap<ShapeKey, Matrices<N>>,
-}
+/// The regular patches' `16 × 16` grid matrices by frame (per thread).
+type FrameCache<const N: usize> = Vec<([[Real; 2]; 2], Matrices<N>)>;
 
 /// One row-major matrix per weight set.
 type Matrices<const N: usize> = [Vec<Real>; N];
@@ -181,13 +212,14 @@ type Matrices<const N: usize> = [Vec<Real>; N];
 /// An irregular patch's local structure and the bits of its frame.
 type ShapeKey = (Vec<u64>, [u64; 4]);
 
-impl<const N: usize> Default for Caches<N> {
-    fn default() -> Self {
-        Caches {
-            frames: Vec::new(),
-            shapes: HashMap::new(),
-        }
-    }
+/// Patch `f`'s inverse frame (base `(u, v)` to its `(s, t)`) and the
+/// frame's |determinant|.
+fn frame(table: &PatchTable, f: usize) -> ([[Real; 2]; 2], Real) {
+    inverse(table.patch_frame(f).1)
+}
+
+fn frame_bits(inv: [[Real; 2]; 2]) -> [u64; 4] {
+    [inv[0][0], inv[0][1], inv[1][0], inv[1][1]].map(Real::to_bits)
 }
 
 /// Inverse of a 2 × 2 matrix and its |determinant|.
@@ -232,24 +264,23 @@ fn add_outer_one<'a>(
     }
 }
 
-/// The element of patch `f` over the level-`L` vertices (columns and
-/// row-major matrix). `caches` keeps the matrices of the frames and
-/// irregular structures seen so far (per thread).
-fn patch_element<const N: usize>(
+/// The element of regular patch `f` over the level-`L` vertices (columns
+/// and row-major matrices). `frames` keeps the grid matrices of the frames
+/// seen so far.
+fn regular_element<const N: usize>(
     table: &PatchTable,
     f: usize,
     gl: &[(Real, Real)],
     c: [[Real; 6]; N],
-    caches: &mut Caches<N>,
+    frames: &mut FrameCache<N>,
 ) -> PatchElement<N> {
     let (_, axes) = table.patch_frame(f);
     let (inv, det) = inverse(axes);
-    let Some(grid) = table.grid_rows(f) else {
-        return irregular_element(table, f, gl, c, (inv, det), caches);
-    };
+    let grid = table
+        .grid_rows(f)
+        .expect("a patch without an irregular structure is regular");
     // Regular: the frame's 16 × 16 grid matrix, carried by the grid rows G
     // (a selection for interior patches) as Gᵀ E G.
-    let frames = &mut caches.frames;
     let e = match frames.iter().position(|(a, _)| *a == axes) {
         Some(i) => &frames[i].1,
         None => {
@@ -278,26 +309,19 @@ fn patch_element<const N: usize>(
     (cols, std::array::from_fn(|i| carried(&e[i], &g, m)))
 }
 
-/// The element of irregular patch `f` (frame `inv`, `det`): the exact
-/// stencils at the Gauss points of the whole patch. Patches with the same
-/// local structure and frame have the same stencils over their quadtree
-/// columns, so the matrix is computed once per structure (per thread) and
-/// reordered to each patch's sorted columns.
+/// The element of irregular patch `f`: the exact stencils at the Gauss
+/// points of the whole patch, over its quadtree columns `local` when every
+/// stencil lies on them (the third value says so; patches with the same
+/// local structure and frame then have the same matrices up to the column
+/// order), else over the sorted union of the stencils' columns.
 fn irregular_element<const N: usize>(
     table: &PatchTable,
     f: usize,
     gl: &[(Real, Real)],
     c: [[Real; 6]; N],
-    (inv, det): ([[Real; 2]; 2], Real),
-    caches: &mut Caches<N>,
-) -> PatchElement<N> {
-    let shape = table.irregular_shape(f);
-    let frame = [inv[0][0], inv[0][1], inv[1][0], inv[1][1]].map(Real::to_bits);
-    if let Some((local, key)) = &shape
-        && let Some(matrix) = caches.shapes.get(&(key.clone(), frame))
-    {
-        return sorted_element(local, matrix);
-    }
+    local: Option<&[u32]>,
+) -> (Vec<u32>, Matrices<N>, bool) {
+    let (inv, det) = frame(table, f);
     let (sts, ws): (Vec<[Real; 2]>, Vec<Real>) = gl
         .iter()
         .flat_map(|&(a, wa)| gl.iter().map(move |&(b, wb)| ([a, b], wa * wb)))
@@ -313,13 +337,13 @@ fn irregular_element<const N: usize>(
         .collect();
     // The quadtree's columns when every stencil lies on them (exact
     // evaluations in the innermost cells do too), else their sorted union.
-    let local = shape.as_ref().map(|(local, _)| local).filter(|local| {
+    let local = local.filter(|local| {
         samples
             .iter()
             .all(|(s, _)| s.cols.iter().all(|c| local.contains(c)))
     });
     let cols: Vec<u32> = match local {
-        Some(local) => local.clone(),
+        Some(local) => local.to_vec(),
         None => {
             let mut cols: Vec<u32> = samples.iter().flat_map(|(s, _)| s.cols.clone()).collect();
             cols.sort_unstable();
@@ -346,14 +370,7 @@ fn irregular_element<const N: usize>(
         }
         add_outer(&mut matrix, m, c, *w, |q| &dense[q]);
     }
-    match (local.is_some(), shape) {
-        (true, Some((local, key))) => {
-            let element = sorted_element(&local, &matrix);
-            caches.shapes.insert((key, frame), matrix);
-            element
-        }
-        _ => (cols, matrix),
-    }
+    (cols, matrix, local.is_some())
 }
 
 /// Columns `cols` sorted, with each row-major `m × m` matrix over them

@@ -39,6 +39,7 @@ use crate::dynamics::{
 };
 use crate::error::{Error, Result};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use rayon::prelude::*;
 
 use crate::forces::{PatchAssembly, RobustKernel, robust_weights};
 use crate::limit::{
@@ -65,10 +66,9 @@ enum Carried {
     /// At `(s, t)` of this base face of the new control mesh (located on
     /// its patches once they are built).
     Face(u32, [Real; 2]),
-    /// At `(s, t)` of this patch of the new control mesh.
+    /// At `(s, t)` of this patch of the new control mesh (the same surface
+    /// piece, or where its face gained corners a nearby one: a start only).
     Patch(u32, [Real; 2]),
-    /// Not carried: its face changed shape.
-    None,
 }
 
 /// A fitted model and what it took.
@@ -202,8 +202,6 @@ pub fn fit_point_cloud(
                         (g as u32, st)
                     }
                     Carried::Patch(g, st) => (g, st),
-                    // Out of range: a full search.
-                    Carried::None => (u32::MAX, [0.5; 2]),
                 })
                 .collect()
         });
@@ -226,12 +224,14 @@ pub fn fit_point_cloud(
                 Some(h) if steps % params.reseed_every != 0 => {
                     engine.closest_points_local(used, h)?
                 }
-                // A previous level's answers cover a prefix of the points.
+                // A previous level's answers cover a prefix of the points;
+                // the others start from the answer of their nearest point
+                // in that prefix.
                 Some(h) => {
                     let k = h.len().min(used.len());
-                    let mut c = engine.closest_points_near(&used[..k], &h[..k])?;
-                    c.extend(engine.closest_points(&used[k..])?);
-                    c
+                    let mut starts = h[..k].to_vec();
+                    starts.extend(nearest_answers(&used[..k], &h[..k], &used[k..]));
+                    engine.closest_points_near(used, &starts)?
                 }
                 None => engine.closest_points(used)?,
             };
@@ -251,7 +251,7 @@ pub fn fit_point_cloud(
                 // onto the data too. Huber weights bound the pull.
                 let xs = centres.apply(&p)?;
                 let near: Vec<(Point3, Real)> = xs
-                    .iter()
+                    .par_iter()
                     .map(|x| {
                         let nn = data_tree.nearest_one::<SquaredEuclidean>(&[x.x, x.y, x.z]);
                         (data[nn.item as usize], nn.distance.sqrt())
@@ -473,10 +473,9 @@ pub fn fit_point_cloud(
                         .iter()
                         .map(|&(p, st)| match local.corner_image[p as usize] {
                             CornerImage::Face(g) => Carried::Face(g, st),
-                            CornerImage::Corner(g, i) => {
+                            CornerImage::Corner(g, i) | CornerImage::Changed(g, i) => {
                                 Carried::Patch(local.mesh.face_offsets[g as usize] + i, st)
                             }
-                            CornerImage::Changed => Carried::None,
                         })
                         .collect(),
                 );
@@ -509,6 +508,26 @@ pub fn fit_point_cloud(
             seconds: start.elapsed().as_secs_f64(),
         },
     })
+}
+
+/// For every query, the closest-point answer (patch and `(s, t)`) of its
+/// nearest `known` point: a start for its own search.
+fn nearest_answers(
+    known: &[Point3],
+    answers: &[(u32, [Real; 2])],
+    queries: &[Point3],
+) -> Vec<(u32, [Real; 2])> {
+    if queries.is_empty() || known.is_empty() {
+        // No start: out of range, a full search.
+        return vec![(u32::MAX, [0.5; 2]); queries.len()];
+    }
+    let tree = ImmutableKdTree::<Real, 3>::new_from_slice(
+        &known.iter().map(|p| [p.x, p.y, p.z]).collect::<Vec<_>>(),
+    );
+    queries
+        .par_iter()
+        .map(|q| answers[tree.nearest_one::<SquaredEuclidean>(&[q.x, q.y, q.z]).item as usize])
+        .collect()
 }
 
 /// `mesh` with its `marked` faces split ([`refine_marked`]; `h` is one

@@ -178,25 +178,41 @@ impl ClosestPointEngine {
     }
 
     /// The closest point to `q`, also trying a start at `hint` (a patch and
-    /// its `(s, t)`, e.g. the previous answer while the surface moves); with
-    /// a hint only the nearest seed of the k-d tree is tried besides it.
+    /// its `(s, t)`, e.g. the previous answer while the surface moves). With
+    /// a hint, the descent from it comes first, and the nearest seed of the
+    /// k-d tree is descended from too only when that seed is itself closer
+    /// to `q` than the hint's answer: a descent never ends farther than it
+    /// starts, so either way the answer is at least as close as every seed,
+    /// as without a hint. A hint whose patch is out of range counts as none.
     pub fn closest_point_near(
         &self,
         q: Point3,
         hint: Option<(u32, [Real; 2])>,
     ) -> Result<ClosestPoint> {
         check_query(q)?;
-        let candidates = if hint.is_some() {
-            1
-        } else {
-            self.params.candidates
-        };
-        let k = NonZero::new(candidates.min(self.seeds.len())).unwrap_or(NonZero::<usize>::MIN);
-        let near = self
-            .seed_tree()?
-            .nearest_n::<SquaredEuclidean>(&[q.x, q.y, q.z], k);
-        let starts = near.iter().map(|nn| self.seeds[nn.item as usize]);
-        self.best_descent(q, starts.chain(hint))
+        let tree = self.seed_tree()?;
+        let at = [q.x, q.y, q.z];
+        match hint.filter(|h| (h.0 as usize) < self.table.num_patches()) {
+            Some(h) => {
+                let (from_hint, settled) = self.best_descent(q, std::iter::once(h))?;
+                let seed = tree.nearest_one::<SquaredEuclidean>(&at);
+                if !settled || seed.distance.sqrt() < from_hint.distance {
+                    let (from_seed, _) =
+                        self.best_descent(q, std::iter::once(self.seeds[seed.item as usize]))?;
+                    if from_seed.distance < from_hint.distance {
+                        return Ok(from_seed);
+                    }
+                }
+                Ok(from_hint)
+            }
+            None => {
+                let k = NonZero::new(self.params.candidates.min(self.seeds.len()))
+                    .unwrap_or(NonZero::<usize>::MIN);
+                let near = tree.nearest_n::<SquaredEuclidean>(&at, k);
+                self.best_descent(q, near.iter().map(|nn| self.seeds[nn.item as usize]))
+                    .map(|(c, _)| c)
+            }
+        }
     }
 
     /// The closest point to `q` reached by descending from `start` alone (a
@@ -204,36 +220,38 @@ impl ClosestPointEngine {
     /// when the surface has moved little since `start` was found.
     pub fn closest_point_local(&self, q: Point3, start: (u32, [Real; 2])) -> Result<ClosestPoint> {
         check_query(q)?;
-        self.best_descent(q, std::iter::once(start))
+        self.best_descent(q, std::iter::once(start)).map(|(c, _)| c)
     }
 
-    /// The nearest of the descents from `starts` (out-of-range patches skipped).
+    /// The nearest of the descents from `starts` (out-of-range patches
+    /// skipped), and whether that descent settled within its iterations.
     fn best_descent(
         &self,
         q: Point3,
         starts: impl Iterator<Item = (u32, [Real; 2])>,
-    ) -> Result<ClosestPoint> {
+    ) -> Result<(ClosestPoint, bool)> {
         let starts = starts.filter(|h| (h.0 as usize) < self.table.num_patches());
-        let mut best: Option<(Real, usize, [Real; 2], PatchPoint)> = None;
+        let mut best: Option<(Real, usize, [Real; 2], PatchPoint, bool)> = None;
         for (f, st) in starts {
-            let (f, st, e) = self.descend(q, f as usize, st)?;
+            let (f, st, e, settled) = self.descend(q, f as usize, st)?;
             let d = (e.p - q).norm();
             if best.as_ref().is_none_or(|b| d < b.0) {
-                best = Some((d, f, st, e));
+                best = Some((d, f, st, e, settled));
             }
         }
-        let (d, f, st, e) = best.ok_or_else(|| Error::Input("no seed found".into()))?;
+        let (d, f, st, e, settled) = best.ok_or_else(|| Error::Input("no seed found".into()))?;
         // Orientation of (s, t) relative to (u, v) decides the normal's sign.
         let normal = (e.d[0].cross(&e.d[1]) * self.table.orientation(f))
             .try_normalize(0.0)
             .unwrap_or_else(Vector3::zeros);
-        Ok(ClosestPoint {
+        let found = ClosestPoint {
             sample: self.table.sample(f, st),
             point: e.p,
             distance: d,
             normal,
             patch: (f as u32, st),
-        })
+        };
+        Ok((found, settled))
     }
 
     /// The patch table the engine searches.
@@ -250,10 +268,7 @@ impl ClosestPointEngine {
         hints: &[(u32, [Real; 2])],
     ) -> Result<Vec<ClosestPoint>> {
         self.seed_tree()?;
-        let n = self.table.num_patches();
-        self.each_with_start(queries, hints, |q, h| {
-            self.closest_point_near(q, Some(h).filter(|h| (h.0 as usize) < n))
-        })
+        self.each_with_start(queries, hints, |q, h| self.closest_point_near(q, Some(h)))
     }
 
     /// [`closest_point_local`](Self::closest_point_local) for many queries,
@@ -293,13 +308,14 @@ impl ClosestPointEngine {
         queries.par_iter().map(|&q| self.closest_point(q)).collect()
     }
 
-    /// Projected Newton descent from `(f, st)`, crossing into neighbouring patches.
+    /// Projected Newton descent from `(f, st)`, crossing into neighbouring
+    /// patches; false when it was still moving after the last iteration.
     fn descend(
         &self,
         q: Point3,
         mut f: usize,
         mut st: [Real; 2],
-    ) -> Result<(usize, [Real; 2], PatchPoint)> {
+    ) -> Result<(usize, [Real; 2], PatchPoint, bool)> {
         let mut e = self.table.eval(f, st)?;
         let mut crossings = 0;
         let tol = self.params.tolerance;
@@ -315,7 +331,9 @@ impl ClosestPointEngine {
                 gn[2] + e.d[4].dot(&r),
             ];
             let step = solve_spd(nh, g).or_else(|| solve_spd(gn, g));
-            let Some(mut step) = step else { break };
+            let Some(mut step) = step else {
+                return Ok((f, st, e, true));
+            };
             // On a true boundary (no patch across), slide along it: drop the
             // blocked component and take the 1-D Newton step along the edge.
             for i in 0..2 {
@@ -339,7 +357,7 @@ impl ClosestPointEngine {
                 }
             }
             if step == [0.0, 0.0] {
-                break;
+                return Ok((f, st, e, true));
             }
             // Limit the step to half a patch.
             let len = (step[0] * step[0] + step[1] * step[1]).sqrt();
@@ -381,7 +399,9 @@ impl ClosestPointEngine {
                 }
                 a *= 0.5;
             }
-            let Some((cand, ce, a)) = accepted else { break };
+            let Some((cand, ce, a)) = accepted else {
+                return Ok((f, st, e, true));
+            };
             let moved = ((cand[0] - st[0]).powi(2) + (cand[1] - st[1]).powi(2)).sqrt();
             st = cand;
             e = ce;
@@ -397,10 +417,10 @@ impl ClosestPointEngine {
                 continue;
             }
             if moved < tol {
-                break;
+                return Ok((f, st, e, true));
             }
         }
-        Ok((f, st, e))
+        Ok((f, st, e, false))
     }
 
     /// The same surface point seen from the patch across edge `k` of patch `f`.

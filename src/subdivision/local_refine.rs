@@ -53,8 +53,10 @@ pub enum CornerImage {
     /// The same level-1 sub-face of a child face that kept the parent's
     /// corners: child face, corner.
     Corner(u32, u32),
-    /// The sub-face of a face that gained corners: its shape changed.
-    Changed,
+    /// The sub-face of a face that gained corners: its shape changed, and
+    /// the child face's sub-face at the same corner vertex (child face,
+    /// corner) is another surface piece nearby (a start for searches only).
+    Changed(u32, u32),
 }
 
 /// The marks extended until no unmarked face has at least half of its edges
@@ -174,11 +176,12 @@ pub fn refine_marked(
                 }
             }
             let g = faces.len() as u32;
-            corner_image.extend((0..n as u32).map(|i| {
+            corner_image.extend((0..n).map(|i| {
                 if face.len() == n {
-                    CornerImage::Corner(g, i)
+                    CornerImage::Corner(g, i as u32)
                 } else {
-                    CornerImage::Changed
+                    let j = face.iter().position(|&v| v == fv[i]).unwrap_or(i);
+                    CornerImage::Changed(g, j as u32)
                 }
             }));
             faces.push(face);
