@@ -26,19 +26,16 @@ pub(super) fn shuffled_order(n: usize) -> Vec<usize> {
 /// `per_side × per_side` cell centres of every patch of `table` (rows over
 /// its level-`L` vertices): where the surface-to-data springs attach.
 pub(super) fn surface_samples(table: &PatchTable, per_side: usize) -> StencilTable {
-    let mut rows = StencilTable::with_capacity(
+    let per_patch = per_side * per_side;
+    StencilTable::from_row_fn(
+        per_patch * table.num_patches(),
         table.to_level().num_rows(),
-        per_side * per_side * table.num_patches(),
-        0,
-    );
-    for f in 0..table.num_patches() {
-        for i in 0..per_side * per_side {
+        |r, b| {
+            let i = r % per_patch;
             let st = [i % per_side, i / per_side].map(|k| (k as Real + 0.5) / per_side as Real);
-            let (cols, w) = table.position_stencil(f, st);
-            rows.push_row(cols.into_iter().zip(w));
-        }
-    }
-    rows
+            table.visit_position_weights(r / per_patch, st, |c, w| b.add(c, w));
+        },
+    )
 }
 
 /// Root mean square of the smallest `fraction` of `d`.

@@ -55,7 +55,7 @@ impl PatchAssembly {
         let level = table.level();
         let s = table.to_level();
         let n = s.num_cols;
-        let rings: Vec<(Vec<u32>, Vec<u32>)> = (0..table.num_patches())
+        let rings: Vec<(Vec<u32>, Vec<u32>, Vec<u16>)> = (0..table.num_patches())
             .into_par_iter()
             .map(|f| {
                 let mut ring = Vec::with_capacity(16);
@@ -73,10 +73,26 @@ impl PatchAssembly {
                     .collect();
                 sup.sort_unstable();
                 sup.dedup();
-                (ring, sup)
+                // Where each ring vertex's row of S sits in the support
+                // (checked below to fit in u16).
+                let at: Vec<u16> = ring
+                    .iter()
+                    .flat_map(|&w| s.row(w as usize).0)
+                    .map(|c| sup.binary_search(c).unwrap_or(0) as u16)
+                    .collect();
+                (ring, sup, at)
             })
             .collect();
-        let (rings, supports): (Vec<Vec<u32>>, Vec<Vec<u32>>) = rings.into_iter().unzip();
+        let mut supports = Vec::with_capacity(rings.len());
+        let mut positions = Vec::with_capacity(rings.len());
+        let rings: Vec<Vec<u32>> = rings
+            .into_iter()
+            .map(|(ring, sup, at)| {
+                supports.push(sup);
+                positions.push(at);
+                ring
+            })
+            .collect();
         if let Some(big) = supports.iter().find(|sup| sup.len() > u16::MAX as usize) {
             return Err(Error::Input(format!(
                 "a patch depends on {} control points, more than 65,535",
@@ -85,18 +101,7 @@ impl PatchAssembly {
         }
         let support_offsets = offsets_of(supports.iter().map(Vec::len));
         let ring_offsets = offsets_of(rings.iter().map(Vec::len));
-        let ring_positions: Vec<u16> = rings
-            .iter()
-            .zip(&supports)
-            .flat_map(|(ring, sup)| {
-                ring.iter().flat_map(|&w| {
-                    s.row(w as usize)
-                        .0
-                        .iter()
-                        .map(|c| sup.binary_search(c).unwrap_or(0) as u16)
-                })
-            })
-            .collect();
+        let ring_positions: Vec<u16> = positions.concat();
         let ring: Vec<u32> = rings.concat();
         let ring_map = offsets_of(ring.iter().map(|&w| s.row(w as usize).0.len()));
         let support: Vec<u32> = supports.concat();

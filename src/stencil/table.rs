@@ -22,8 +22,16 @@ pub struct StencilTable {
     pub weights: Vec<Real>,
 }
 
-/// Rows per parallel task when applying or composing tables.
+/// Most rows per parallel task when applying, composing or building tables.
 const CHUNK: usize = 4096;
+
+/// Rows per parallel task for a table of `n` rows: about eight tasks per
+/// thread, so that uneven rows (exact evaluations near extraordinary
+/// vertices) still share out, and at most [`CHUNK`].
+fn chunk_rows(n: usize) -> usize {
+    n.div_ceil(8 * rayon::current_num_threads().max(1))
+        .clamp(256, CHUNK)
+}
 
 impl StencilTable {
     /// The `n × n` identity.
@@ -114,10 +122,11 @@ impl StencilTable {
     pub fn apply_into(&self, points: &[Point3], out: &mut [Point3]) {
         assert_eq!(points.len(), self.num_cols);
         assert_eq!(out.len(), self.num_rows());
-        out.par_chunks_mut(CHUNK)
+        let rows = chunk_rows(out.len());
+        out.par_chunks_mut(rows)
             .enumerate()
             .for_each(|(ci, chunk)| {
-                let r0 = ci * CHUNK;
+                let r0 = ci * rows;
                 for (i, o) in chunk.iter_mut().enumerate() {
                     let (a, b) = (self.offsets[r0 + i], self.offsets[r0 + i + 1]);
                     let (mut x, mut y, mut z) = (0.0, 0.0, 0.0);
@@ -210,12 +219,13 @@ impl StencilTable {
         let ncols = inner.num_cols;
         // Per-thread dense accumulator with a list of touched columns (a sparse
         // accumulator), so each output row costs only its own fill.
-        let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<Real>)> = (0..n.div_ceil(CHUNK))
+        let rows = chunk_rows(n);
+        let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<Real>)> = (0..n.div_ceil(rows))
             .into_par_iter()
             .map_init(
                 || (vec![0.0; ncols], vec![false; ncols], Vec::<u32>::new()),
                 |(acc, seen, touched), ci| {
-                    let (r0, r1) = (ci * CHUNK, ((ci + 1) * CHUNK).min(n));
+                    let (r0, r1) = (ci * rows, ((ci + 1) * rows).min(n));
                     let mut lens = Vec::with_capacity(r1 - r0);
                     let mut idx = Vec::new();
                     let mut wts = Vec::new();
@@ -330,8 +340,9 @@ impl StencilTable {
         num_cols: usize,
         row: impl Fn(usize, &mut RowBuilder) + Sync,
     ) -> StencilTable {
+        let rows = chunk_rows(num_rows);
         let chunk = |b: &mut RowBuilder, ci: usize| {
-            let (r0, r1) = (ci * CHUNK, ((ci + 1) * CHUNK).min(num_rows));
+            let (r0, r1) = (ci * rows, ((ci + 1) * rows).min(num_rows));
             let mut lens = Vec::with_capacity(r1 - r0);
             let mut idx = Vec::with_capacity(8 * (r1 - r0));
             let mut wts = Vec::with_capacity(8 * (r1 - r0));
@@ -344,7 +355,7 @@ impl StencilTable {
             }
             (lens, idx, wts)
         };
-        let nchunks = num_rows.div_ceil(CHUNK);
+        let nchunks = num_rows.div_ceil(rows);
         let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<Real>)> = if nchunks <= 1 {
             let mut b = RowBuilder::default();
             (0..nchunks).map(|ci| chunk(&mut b, ci)).collect()

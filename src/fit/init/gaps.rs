@@ -17,6 +17,7 @@
 //! sampled (28 of 4,773 samples on the 8-view Spot scan).
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use rayon::prelude::*;
 
 use crate::math::{Point3, Real, Vector3};
 
@@ -43,7 +44,7 @@ pub fn narrow_gap(
     let stride = points.len().div_ceil(SAMPLES).max(1);
     let steps = (reach / step).ceil() as usize;
     let mut gaps: Vec<Real> = points
-        .iter()
+        .par_iter()
         .zip(normals)
         .step_by(stride)
         .filter_map(|(p, n)| {

@@ -27,6 +27,7 @@ use std::collections::BinaryHeap;
 use std::num::NonZero;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use rayon::prelude::*;
 
 use crate::math::{Point3, Real, Vector3};
 
@@ -41,7 +42,7 @@ pub const PLANES: usize = 4;
 pub fn oriented_normals(points: &[Point3], tree: &ImmutableKdTree<Real, 3>) -> Vec<Vector3> {
     let k = NonZero::new((NEIGHBOURS + 1).min(points.len())).unwrap_or(NonZero::<usize>::MIN);
     let neighbours: Vec<Vec<u32>> = points
-        .iter()
+        .par_iter()
         .map(|p| {
             tree.nearest_n::<SquaredEuclidean>(&[p.x, p.y, p.z], k)
                 .iter()
@@ -50,7 +51,7 @@ pub fn oriented_normals(points: &[Point3], tree: &ImmutableKdTree<Real, 3>) -> V
         })
         .collect();
     let mut normals: Vec<Vector3> = neighbours
-        .iter()
+        .par_iter()
         .map(|nb| plane_normal(points, nb))
         .collect();
     // Symmetric k-nearest-neighbour graph.
