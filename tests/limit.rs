@@ -1153,3 +1153,33 @@ fn closest_point_near_recovers_from_a_hint_on_the_far_side() {
         }
     }
 }
+
+/// Patch tables sharing one quadtree cache (as the levels of a fit do)
+/// evaluate exactly as tables with their own: a structure's leaves depend
+/// on nothing but the structure.
+#[test]
+fn shared_quadtree_cache_changes_no_evaluation() {
+    let shared = subdyn::limit::QuadtreeCache::default();
+    for (mesh, name) in [
+        (pentagonal_pyramid(), "pentagonal pyramid"),
+        (mixed_mesh(), "mixed mesh"),
+        (subdyn::examples::cube(), "cube"),
+    ] {
+        let r = default_refiner(&mesh);
+        let own = PatchTable::new(&r, &mesh.positions, 1).unwrap();
+        let with_shared =
+            PatchTable::with_quadtrees(&r, &mesh.positions, 1, shared.clone()).unwrap();
+        for f in 0..own.num_patches() {
+            for st in [[0.5, 0.5], [0.1, 0.7], [0.004, 0.002], [0.3, 0.0]] {
+                let (a, b) = (own.eval(f, st).unwrap(), with_shared.eval(f, st).unwrap());
+                assert!(
+                    a.p == b.p && a.d == b.d,
+                    "{name}: patch {f} at {st:?}: {:?} against {:?}",
+                    a,
+                    b
+                );
+            }
+        }
+    }
+    assert!(format!("{shared:?}").contains("structures"));
+}

@@ -43,7 +43,7 @@ use rayon::prelude::*;
 
 use crate::forces::{PatchAssembly, RobustKernel, robust_weights};
 use crate::limit::{
-    ClosestPointEngine, ClosestPointParams, interpolate_limit_points, limit_stencil,
+    ClosestPointEngine, ClosestPointParams, QuadtreeCache, interpolate_limit_points, limit_stencil,
 };
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
@@ -134,11 +134,14 @@ pub fn fit_point_cloud(
     // The parent of an adaptive level, kept to refine it uniformly instead
     // should the adaptive level fit worse.
     let mut adaptive_parent: Option<PolyMesh> = None;
+    // Most local structures at extraordinary vertices recur from level to
+    // level: their quadtrees are built once.
+    let quadtrees = QuadtreeCache::default();
     let (converged, stop_reason) = loop {
         let level = levels.len();
         let level_start = Instant::now();
         let refiner = Refiner::new(&mesh, &RefineOptions::default())?;
-        let mut engine = ClosestPointEngine::new(
+        let mut engine = ClosestPointEngine::with_quadtrees(
             &refiner,
             &mesh.positions,
             &ClosestPointParams {
@@ -148,6 +151,7 @@ pub fn fit_point_cloud(
                 tolerance: 1e-7,
                 ..Default::default()
             },
+            quadtrees.clone(),
         )?;
         // The thin plate and the damping, patch by patch on the engine's
         // pieces: exact on regular faces (one bicubic each).

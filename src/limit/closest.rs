@@ -27,7 +27,7 @@ use crate::topology::NONE;
 
 use super::Sample;
 use super::patch::CORNERS;
-use super::patch_table::{PatchPoint, PatchTable};
+use super::patch_table::{PatchPoint, PatchTable, QuadtreeCache};
 
 /// Options of [`ClosestPointEngine::new`].
 #[derive(Clone, Debug)]
@@ -92,6 +92,17 @@ impl ClosestPointEngine {
         positions: &[Point3],
         params: &ClosestPointParams,
     ) -> Result<Self> {
+        Self::with_quadtrees(refiner, positions, params, QuadtreeCache::default())
+    }
+
+    /// [`new`](Self::new) with the patch table's quadtrees shared through
+    /// `shapes` ([`PatchTable::with_quadtrees`]).
+    pub fn with_quadtrees(
+        refiner: &Refiner,
+        positions: &[Point3],
+        params: &ClosestPointParams,
+        shapes: QuadtreeCache,
+    ) -> Result<Self> {
         if params.level == 0 || params.level > 6 {
             return Err(Error::Input(format!(
                 "closest-point level {} must be between 1 and 6",
@@ -120,7 +131,7 @@ impl ClosestPointEngine {
             return Err(Error::Input("the control mesh has no faces".into()));
         }
         let n = params.seeds_per_side;
-        let table = PatchTable::new(refiner, positions, params.level)?;
+        let table = PatchTable::with_quadtrees(refiner, positions, params.level, shapes)?;
         let seeds: Vec<(u32, [Real; 2])> = (0..table.num_patches() as u32)
             .flat_map(|f| {
                 (0..n * n).map(move |i| {

@@ -18,6 +18,6 @@ pub use interpolate::interpolate_limit_points;
 pub use limit_stencil::{limit_stencil, limit_tangent_stencils};
 pub use patch::SampleStencil;
 pub(crate) use patch_table::chain as chain_rule;
-pub use patch_table::{PatchPoint, PatchTable, TREE_DEPTH};
+pub use patch_table::{PatchPoint, PatchTable, QuadtreeCache, TREE_DEPTH};
 pub use tessellate::tessellate;
 pub use vertex_masks::CornerKind;

@@ -117,15 +117,43 @@ pub struct PatchTable {
     /// Face offsets of levels `0..L`, to locate a base `(face, u, v)`.
     offsets: Vec<Vec<u32>>,
     patches: Vec<Patch>,
-    /// Quadtree leaves by the one-ring's [`LocalPatch::shape_key`]:
-    /// irregular faces with the same local structure (most faces at
-    /// extraordinary vertices of one valence) share their weights.
-    shapes: Mutex<HashMap<Vec<u64>, Arc<Vec<Leaf>>>>,
+    /// Quadtree leaves by local structure (see [`QuadtreeCache`]).
+    shapes: QuadtreeCache,
+}
+
+/// Quadtree leaves by the one-ring's local structure
+/// ([`LocalPatch::shape_key`]): irregular faces with the same structure
+/// (most faces at extraordinary vertices of one valence) share their
+/// weights, which depend on nothing else. Every [`PatchTable`] keeps one;
+/// tables built one after the other over related meshes (the levels of a
+/// fit, whose refinements keep most structures) can share one through
+/// [`PatchTable::with_quadtrees`], which a clone of the cache does.
+#[derive(Clone, Default)]
+pub struct QuadtreeCache(Arc<Mutex<Shapes>>);
+
+/// Leaves by [`LocalPatch::shape_key`].
+type Shapes = HashMap<Vec<u64>, Arc<Vec<Leaf>>>;
+
+impl std::fmt::Debug for QuadtreeCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let n = self.0.lock().map_or(0, |s| s.len());
+        write!(f, "QuadtreeCache({n} structures)")
+    }
 }
 
 impl PatchTable {
     /// Refines to `level` (1 to 6) and builds the regular patches.
     pub fn new(refiner: &Refiner, positions: &[Point3], level: usize) -> Result<PatchTable> {
+        Self::with_quadtrees(refiner, positions, level, QuadtreeCache::default())
+    }
+
+    /// [`new`](Self::new) with quadtrees looked up in and added to `shapes`.
+    pub fn with_quadtrees(
+        refiner: &Refiner,
+        positions: &[Point3],
+        level: usize,
+        shapes: QuadtreeCache,
+    ) -> Result<PatchTable> {
         if level == 0 || level > 6 {
             return Err(Error::Input(format!(
                 "patch level {level} must be between 1 and 6"
@@ -188,7 +216,7 @@ impl PatchTable {
                 .map(|l| l.face_offsets.clone())
                 .collect(),
             patches,
-            shapes: Mutex::new(HashMap::new()),
+            shapes,
         };
         table.set_positions(positions)?;
         Ok(table)
@@ -511,10 +539,10 @@ impl PatchTable {
         let root = LocalPatch::around(&self.level, &self.sharp, f);
         let cols = root.cols.clone();
         let key = root.shape_key();
-        let cached = self.shapes.lock().ok().and_then(|s| s.get(&key).cloned());
+        let cached = self.shapes.0.lock().ok().and_then(|s| s.get(&key).cloned());
         let shape = cached.unwrap_or_else(|| {
             let shape = Arc::new(Self::leaves(root));
-            if let Ok(mut shapes) = self.shapes.lock() {
+            if let Ok(mut shapes) = self.shapes.0.lock() {
                 shapes.insert(key, shape.clone());
             }
             shape
