@@ -247,12 +247,11 @@ pub fn fit_point_cloud(
             // must not be dominated by outliers (the full RMS is) nor jump as
             // the robust weights admit or drop points (the inliers' RMS does).
             let trimmed = trimmed_rms(&dist, 0.95);
-            let mut springs = assembly.data_springs(engine.table(), used, &closest, &kw)?;
-            if params.surface_weight > 0.0 {
-                // Surface-to-data springs: every surface sample to its
-                // nearest data point, so parts of the surface that no data
-                // point is closest to (bridges across gaps, flaps) are pulled
-                // onto the data too. Huber weights bound the pull.
+            // Surface-to-data springs: every surface sample to its nearest
+            // data point, so parts of the surface that no data point is
+            // closest to (bridges across gaps, flaps) are pulled onto the
+            // data too. Huber weights bound the pull.
+            let surface = if params.surface_weight > 0.0 {
                 let xs = centres.apply(&p)?;
                 let near: Vec<(Point3, Real)> = xs
                     .par_iter()
@@ -266,16 +265,20 @@ pub fn fit_point_cloud(
                 let m = xs.len() as Real;
                 let ks: Vec<Real> = ws.iter().map(|w| params.surface_weight * w / m).collect();
                 let targets: Vec<Point3> = near.iter().map(|n| n.0).collect();
-                springs.add(&assembly.row_springs(
-                    &centres,
-                    |i| i / per_patch,
-                    &xs,
-                    &targets,
-                    &ks,
-                )?)?;
-            }
+                Some((xs, targets, ks, dd))
+            } else {
+                None
+            };
+            // The energy first (the springs' ½ k d² and ½ pᵀ K p): the
+            // systems are assembled only when another step follows.
+            let spring_energy = |d: &[Real], k: &[Real]| -> Real {
+                d.iter().zip(k).map(|(d, k)| 0.5 * k * d * d).sum()
+            };
             let kp = k.apply(&p)?;
-            let e = springs.energy
+            let e = spring_energy(&dist, &kw)
+                + surface
+                    .as_ref()
+                    .map_or(0.0, |(_, _, ks, dd)| spring_energy(dd, ks))
                 + 0.5
                     * kp.iter()
                         .zip(&p)
@@ -294,6 +297,16 @@ pub fn fit_point_cloud(
             step_p95_pct.push(stats.p95_pct);
             if settled || steps >= params.max_steps {
                 break (dist, hints);
+            }
+            let mut springs = assembly.data_springs(engine.table(), used, &closest, &kw)?;
+            if let Some((xs, targets, ks, _)) = &surface {
+                springs.add(&assembly.row_springs(
+                    &centres,
+                    |i| i / per_patch,
+                    xs,
+                    targets,
+                    ks,
+                )?)?;
             }
             let mut a = springs.matrix;
             for (x, y) in a.weights.iter_mut().zip(&kd_values) {
