@@ -171,15 +171,19 @@ fn elements<const N: usize>(
         .collect();
     Ok((0..table.num_patches())
         .into_par_iter()
-        .map_init(Vec::new, |frames, f| match &shapes[f] {
-            None => regular_element(table, f, &gl, c, frames),
-            Some((local, key)) => match &shared[key] {
-                Some(matrices) => sorted_element(local, matrices),
-                None => {
-                    let (cols, matrices, _) = irregular_element(table, f, &gl, c, None);
-                    (cols, matrices)
-                }
-            },
+        .map_init(Vec::new, |frames, f| {
+            let own = || {
+                let (cols, matrices, _) = irregular_element(table, f, &gl, c, None);
+                (cols, matrices)
+            };
+            match (table.grid_rows(f), &shapes[f]) {
+                (Some(grid), _) => regular_element(table, f, grid, &gl, c, frames),
+                (None, Some((local, key))) => match &shared[key] {
+                    Some(matrices) => sorted_element(local, matrices),
+                    None => own(),
+                },
+                (None, None) => own(),
+            }
         })
         .collect())
 }
@@ -264,21 +268,19 @@ fn add_outer_one<'a>(
     }
 }
 
-/// The element of regular patch `f` over the level-`L` vertices (columns
-/// and row-major matrices). `frames` keeps the grid matrices of the frames
-/// seen so far.
+/// The element of regular patch `f` (its 16 grid rows `grid`) over the
+/// level-`L` vertices (columns and row-major matrices). `frames` keeps the
+/// grid matrices of the frames seen so far.
 fn regular_element<const N: usize>(
     table: &PatchTable,
     f: usize,
+    grid: [(&[u32], &[Real]); 16],
     gl: &[(Real, Real)],
     c: [[Real; 6]; N],
     frames: &mut FrameCache<N>,
 ) -> PatchElement<N> {
     let (_, axes) = table.patch_frame(f);
     let (inv, det) = inverse(axes);
-    let grid = table
-        .grid_rows(f)
-        .expect("a patch without an irregular structure is regular");
     // Regular: the frame's 16 × 16 grid matrix, carried by the grid rows G
     // (a selection for interior patches) as Gᵀ E G.
     let e = match frames.iter().position(|(a, _)| *a == axes) {
