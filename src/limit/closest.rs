@@ -192,9 +192,11 @@ impl ClosestPointEngine {
     /// its `(s, t)`, e.g. the previous answer while the surface moves). With
     /// a hint, the descent from it comes first, and the nearest seed of the
     /// k-d tree is descended from too only when that seed is itself closer
-    /// to `q` than the hint's answer: a descent never ends farther than it
-    /// starts, so either way the answer is at least as close as every seed,
-    /// as without a hint. A hint whose patch is out of range counts as none.
+    /// to `q` than the hint's answer or the hint's descent was still moving
+    /// after its last iteration (a far hint): a descent never ends farther
+    /// than it starts, so either way the answer is at least as close as
+    /// every seed, as without a hint. A hint whose patch is out of range
+    /// counts as none.
     pub fn closest_point_near(
         &self,
         q: Point3,
