@@ -83,16 +83,13 @@ impl PatchAssembly {
                 (ring, sup, at)
             })
             .collect();
-        let mut supports = Vec::with_capacity(rings.len());
-        let mut positions = Vec::with_capacity(rings.len());
-        let rings: Vec<Vec<u32>> = rings
-            .into_iter()
-            .map(|(ring, sup, at)| {
-                supports.push(sup);
-                positions.push(at);
-                ring
-            })
-            .collect();
+        let (mut ring_lists, mut supports, mut positions) = (Vec::new(), Vec::new(), Vec::new());
+        for (ring, sup, at) in rings {
+            ring_lists.push(ring);
+            supports.push(sup);
+            positions.push(at);
+        }
+        let rings = ring_lists;
         if let Some(big) = supports.iter().find(|sup| sup.len() > u16::MAX as usize) {
             return Err(Error::Input(format!(
                 "a patch depends on {} control points, more than 65,535",
