@@ -5,11 +5,14 @@
 //! (Qin, Mandal, Vemuri 1998, eq. 15), and the thin plate `K` and damping
 //! `D` assembled patch by patch, are nonzero only on pairs of control
 //! points that share a patch support. [`PatchAssembly`] computes that
-//! pattern once per control mesh, together with each patch's position of
-//! every support pair in it; a spring then costs one dense outer product of
-//! its row over the support, scattered through the precomputed slots, in
-//! place of composing its stencil with `S` and forming `JᵀJ` by sparse
-//! products every step. The thin plate's and damping's dense patch
+//! pattern once per control mesh, together with the position of every
+//! support pair in it; a spring then costs one dense outer product of its
+//! row over the support, in place of composing its stencil with `S` and
+//! forming `JᵀJ` by sparse products every step. Consecutive patches with the
+//! same support (a regular control face's four corners at level 1) form one
+//! *block* that shares its slots, and the springs of a block are summed in a
+//! dense buffer (its upper triangle: `JᵀJ` is symmetric) that is scattered
+//! through the slots once. The thin plate's and damping's dense patch
 //! elements are carried to the control points the same way
 //! ([`PatchAssembly::values_of_elements`]). The sums are the same as
 //! [`spring_system`](super::spring_system)'s and the sparse `Sᵀ K_L S`'s to
@@ -31,7 +34,10 @@ pub struct PatchAssembly {
     /// Rows (sorted columns) of the pattern over the control points.
     offsets: Vec<usize>,
     indices: Vec<u32>,
-    /// Control points each patch depends on, sorted, patch after patch.
+    /// Each patch's block: consecutive patches with the same support share
+    /// one, and with it their slots.
+    block: Vec<u32>,
+    /// Control points each block depends on, sorted, block after block.
     support_offsets: Vec<usize>,
     support: Vec<u32>,
     /// The level-`L` vertices of each patch's one-ring, sorted, patch after
@@ -41,12 +47,10 @@ pub struct PatchAssembly {
     ring: Vec<u32>,
     ring_map: Vec<usize>,
     ring_positions: Vec<u16>,
-    /// For patch `f` with support of size `m`: `m × m` positions in the
-    /// pattern, row-major, starting at `slot_offsets[f]`.
+    /// For block `b` with support of size `m`: `m × m` positions in the
+    /// pattern, row-major, starting at `slot_offsets[b]`.
     slot_offsets: Vec<usize>,
     slots: Vec<u32>,
-    /// The largest support.
-    max_support: usize,
 }
 
 impl PatchAssembly {
@@ -84,9 +88,13 @@ impl PatchAssembly {
             })
             .collect();
         let (mut ring_lists, mut supports, mut positions) = (Vec::new(), Vec::new(), Vec::new());
+        let mut block = Vec::with_capacity(rings.len());
         for (ring, sup, at) in rings {
+            if supports.last() != Some(&sup) {
+                supports.push(sup);
+            }
+            block.push((supports.len() - 1) as u32);
             ring_lists.push(ring);
-            supports.push(sup);
             positions.push(at);
         }
         let rings = ring_lists;
@@ -133,7 +141,7 @@ impl PatchAssembly {
             .collect();
         let offsets = offsets_of(rows.iter().map(Vec::len));
         let indices = rows.concat();
-        let per_patch: Vec<Vec<u32>> = supports
+        let per_block: Vec<Vec<u32>> = supports
             .par_iter()
             .map(|sup| {
                 let mut out = Vec::with_capacity(sup.len() * sup.len());
@@ -149,7 +157,7 @@ impl PatchAssembly {
                 out
             })
             .collect();
-        let slot_offsets = offsets_of(per_patch.iter().map(Vec::len));
+        let slot_offsets = offsets_of(per_block.iter().map(Vec::len));
         if indices.len() > u32::MAX as usize {
             return Err(Error::Input(format!(
                 "the control-point system would have {} entries, more than 2³² − 1",
@@ -157,9 +165,9 @@ impl PatchAssembly {
             )));
         }
         Ok(PatchAssembly {
-            max_support: supports.iter().map(Vec::len).max().unwrap_or(0),
             offsets,
             indices,
+            block,
             support_offsets,
             support,
             ring_offsets,
@@ -167,7 +175,7 @@ impl PatchAssembly {
             ring_map,
             ring_positions,
             slot_offsets,
-            slots: per_patch.concat(),
+            slots: per_block.concat(),
         })
     }
 
@@ -226,7 +234,8 @@ impl PatchAssembly {
             .par_chunks(chunk)
             .map(|fs| {
                 let mut values = vec![0.0; self.indices.len()];
-                let (mut t, mut c) = (Vec::new(), Vec::new());
+                // `c`: the sum over the patches of `block` so far.
+                let (mut t, mut c, mut block) = (Vec::new(), Vec::new(), None);
                 for &f in fs {
                     let (cols, e) = element(f);
                     let m = cols.len();
@@ -253,8 +262,17 @@ impl PatchAssembly {
                             ))
                         })
                         .collect::<Result<Vec<_>>>()?;
-                    let n = self.support_offsets[f + 1] - self.support_offsets[f];
-                    // T = E S_f (m × n), then C = S_fᵀ T (n × n).
+                    let b = self.block[f] as usize;
+                    let n = self.support_of_block(b).len();
+                    if block != Some(b) {
+                        if let Some(done) = block {
+                            self.scatter(done, &c, &mut values);
+                        }
+                        block = Some(b);
+                        c.clear();
+                        c.resize(n * n, 0.0);
+                    }
+                    // T = E S_f (m × n), then C += S_fᵀ T (n × n).
                     t.clear();
                     t.resize(m * n, 0.0);
                     for (j, (w, at)) in rows.iter().enumerate() {
@@ -264,8 +282,6 @@ impl PatchAssembly {
                             }
                         }
                     }
-                    c.clear();
-                    c.resize(n * n, 0.0);
                     for (i, (w, at)) in rows.iter().enumerate() {
                         for (&x, &a) in w.iter().zip(*at) {
                             let a = a as usize;
@@ -276,10 +292,9 @@ impl PatchAssembly {
                             }
                         }
                     }
-                    let slots = &self.slots[self.slot_offsets[f]..self.slot_offsets[f + 1]];
-                    for (&slot, &x) in slots.iter().zip(&c) {
-                        values[slot as usize] += x;
-                    }
+                }
+                if let Some(done) = block {
+                    self.scatter(done, &c, &mut values);
                 }
                 Ok(values)
             })
@@ -310,28 +325,31 @@ impl PatchAssembly {
     ) -> Result<SpringSystem> {
         check_lengths(points.len(), closest.len(), k.len())?;
         let s = table.to_level();
-        self.springs(points.len(), |i, u| {
-            let (f, st) = closest[i].patch;
-            let f = f as usize;
-            let first = self.ring_offsets[f];
-            let ring = &self.ring[first..self.ring_offsets[f + 1]];
-            let mut outside = None;
-            table.visit_position_weights(f, st, |c, wc| match ring.binary_search(&c) {
-                Ok(j) => {
-                    let at = &self.ring_positions[self.ring_map[first + j]..];
-                    for (&x, &a) in s.row(c as usize).1.iter().zip(at) {
-                        u[a as usize] += wc * x;
+        self.springs(
+            points.len(),
+            |i| closest[i].patch.0 as usize,
+            |i, f, u| {
+                let st = closest[i].patch.1;
+                let first = self.ring_offsets[f];
+                let ring = &self.ring[first..self.ring_offsets[f + 1]];
+                let mut outside = None;
+                table.visit_position_weights(f, st, |c, wc| match ring.binary_search(&c) {
+                    Ok(j) => {
+                        let at = &self.ring_positions[self.ring_map[first + j]..];
+                        for (&x, &a) in s.row(c as usize).1.iter().zip(at) {
+                            u[a as usize] += wc * x;
+                        }
                     }
+                    Err(_) => outside = Some(c),
+                });
+                if let Some(c) = outside {
+                    return Err(Error::Topology(format!(
+                        "level vertex {c} is outside patch {f}'s one-ring"
+                    )));
                 }
-                Err(_) => outside = Some(c),
-            });
-            if let Some(c) = outside {
-                return Err(Error::Topology(format!(
-                    "level vertex {c} is outside patch {f}'s one-ring"
-                )));
-            }
-            Ok((f, closest[i].point, points[i], k[i]))
-        })
+                Ok((closest[i].point, points[i], k[i]))
+            },
+        )
     }
 
     /// Springs from surface points `x[i] = rows[i] · p` on patches
@@ -347,43 +365,86 @@ impl PatchAssembly {
     ) -> Result<SpringSystem> {
         check_lengths(rows.num_rows(), x.len(), d.len())?;
         check_lengths(rows.num_rows(), k.len(), d.len())?;
-        self.springs(d.len(), |i, u| {
-            let f = patch_of(i);
-            let sup = self.support_of(f);
+        self.springs(d.len(), patch_of, |i, f, u| {
+            let sup = self.support_of_block(self.block[f] as usize);
             let (cols, ws) = rows.row(i);
             for (&c, &w) in cols.iter().zip(ws) {
                 u[position(sup, c)?] += w;
             }
-            Ok((f, x[i], d[i], k[i]))
+            Ok((x[i], d[i], k[i]))
         })
     }
 
-    fn support_of(&self, f: usize) -> &[u32] {
-        &self.support[self.support_offsets[f]..self.support_offsets[f + 1]]
+    fn support_of_block(&self, b: usize) -> &[u32] {
+        &self.support[self.support_offsets[b]..self.support_offsets[b + 1]]
     }
 
-    /// Sums `k uuᵀ`, `k u d` and `½ k |x − d|²` over `count` springs;
-    /// `spring(i, u)` writes spring `i`'s row over its patch's support into
-    /// the zeroed `u` and returns the patch, `x`, `d` and `k`.
+    /// Adds block `b`'s dense `m × m` sum `c` (row-major over its support) to
+    /// `values` through its slots.
+    fn scatter(&self, b: usize, c: &[Real], values: &mut [Real]) {
+        let slots = &self.slots[self.slot_offsets[b]..self.slot_offsets[b + 1]];
+        for (&slot, &x) in slots.iter().zip(c) {
+            values[slot as usize] += x;
+        }
+    }
+
+    /// Sums `k uuᵀ`, `k u d` and `½ k |x − d|²` over `count` springs on
+    /// patches `patch_of(i)`; `spring(i, f, u)` writes spring `i`'s row over
+    /// its patch `f`'s support into the zeroed `u` and returns `x`, `d` and
+    /// `k`. The springs are taken block by block, each block's `k uuᵀ`
+    /// summed in a dense upper triangle and scattered once.
     fn springs(
         &self,
         count: usize,
-        spring: impl Fn(usize, &mut [Real]) -> Result<(usize, Point3, Point3, Real)> + Sync,
+        patch_of: impl Fn(usize) -> usize + Sync,
+        spring: impl Fn(usize, usize, &mut [Real]) -> Result<(Point3, Point3, Real)> + Sync,
     ) -> Result<SpringSystem> {
         let n = self.offsets.len() - 1;
+        let patches = self.block.len();
+        let mut order: Vec<(u32, usize)> = Vec::with_capacity(count);
+        for i in 0..count {
+            let f = patch_of(i);
+            if f >= patches {
+                return Err(Error::Input(format!(
+                    "spring {i} is on patch {f} of {patches}"
+                )));
+            }
+            order.push((self.block[f], i));
+        }
+        order.sort_unstable();
         let chunk = count.div_ceil(rayon::current_num_threads().max(1)).max(1);
-        let parts: Vec<(Vec<Real>, Vec<Point3>, Real)> = (0..count)
-            .collect::<Vec<_>>()
+        let parts: Vec<(Vec<Real>, Vec<Point3>, Real)> = order
             .par_chunks(chunk)
             .map(|ids| {
                 let mut values = vec![0.0; self.indices.len()];
                 let mut rhs = vec![Point3::origin(); n];
                 let mut energy = 0.0;
-                let mut u = Vec::new();
-                for &i in ids {
+                let (mut u, mut c, mut block) = (Vec::new(), Vec::new(), None);
+                // Block `b`'s upper triangle, mirrored into its slots.
+                let flush = |b: usize, c: &mut [Real], values: &mut [Real]| {
+                    let m = self.support_of_block(b).len();
+                    for a in 0..m {
+                        for e in a + 1..m {
+                            c[e * m + a] = c[a * m + e];
+                        }
+                    }
+                    self.scatter(b, c, values);
+                };
+                for &(b, i) in ids {
+                    let b = b as usize;
+                    let sup = self.support_of_block(b);
+                    let m = sup.len();
+                    if block != Some(b) {
+                        if let Some(done) = block {
+                            flush(done, &mut c, &mut values);
+                        }
+                        block = Some(b);
+                        c.clear();
+                        c.resize(m * m, 0.0);
+                    }
                     u.clear();
-                    u.resize(self.max_support, 0.0);
-                    let (f, x, d, k) = spring(i, &mut u)?;
+                    u.resize(m, 0.0);
+                    let (x, d, k) = spring(i, patch_of(i), &mut u)?;
                     if k == 0.0 {
                         continue;
                     }
@@ -391,19 +452,19 @@ impl PatchAssembly {
                         return Err(Error::Input(format!("spring {i} has stiffness {k}")));
                     }
                     energy += 0.5 * k * (x - d).norm_squared();
-                    let sup = self.support_of(f);
-                    let m = sup.len();
-                    let slots = &self.slots[self.slot_offsets[f]..self.slot_offsets[f + 1]];
                     for a in 0..m {
                         let ka = k * u[a];
                         if ka == 0.0 {
                             continue;
                         }
                         rhs[sup[a] as usize].coords += ka * d.coords;
-                        for (b, &slot) in slots[a * m..(a + 1) * m].iter().enumerate() {
-                            values[slot as usize] += ka * u[b];
+                        for (o, &y) in c[a * m + a..(a + 1) * m].iter_mut().zip(&u[a..]) {
+                            *o += ka * y;
                         }
                     }
+                }
+                if let Some(done) = block {
+                    flush(done, &mut c, &mut values);
                 }
                 Ok((values, rhs, energy))
             })
