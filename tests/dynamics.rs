@@ -595,10 +595,13 @@ fn patch_assembly_equals_the_sparse_spring_products() {
         let params = MaterialParams::default();
         let elements = stiffness_and_damping_elements(table, 4, &params, 0.3).unwrap();
         let reference = patch_stiffness_and_damping(table, 4, &params, 0.3).unwrap();
-        for (i, reference) in reference.iter().enumerate() {
-            let values = assembly
-                .values_of_elements(table, |f| (&elements[f].0, &elements[f].1[i][..]))
-                .unwrap();
+        let carried = assembly
+            .values_of_elements(table, |f| {
+                let (cols, [k, d]) = &elements[f];
+                (&cols[..], [&k[..], &d[..]])
+            })
+            .unwrap();
+        for (i, (reference, values)) in reference.iter().zip(carried).enumerate() {
             let (worst, m) = table_difference(reference, &assembly.matrix(values));
             assert!(
                 m > 0.0 && worst <= 1e-12 * m,

@@ -112,6 +112,19 @@ fn check_corners(mesh: &PolyMesh, r: &Refiner, name: &str) {
         .unwrap()
         .apply(&mesh.positions)
         .unwrap();
+    // With a level below, vertices of n-gons and semi-sharp vertices take
+    // their vertex points' masks there: the same limit points.
+    let deeper = limit_stencil(&r.refine_uniform(1).unwrap(), 0)
+        .unwrap()
+        .apply(&mesh.positions)
+        .unwrap();
+    for (v, (a, b)) in lp.iter().zip(&deeper).enumerate() {
+        let err = (a - b).norm() / d;
+        assert!(
+            err <= EXACT_TOL,
+            "{name}: vertex {v}: {a} by evaluation, {b} by the masks a level below ({err:e}·diag)"
+        );
+    }
     let eval = LimitEvaluator::new(r);
     for f in 0..mesh.num_faces() {
         let fv = mesh.face(f);

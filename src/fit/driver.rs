@@ -166,10 +166,12 @@ pub fn fit_point_cloud(
             &material,
             params.damping / area,
         )?;
-        let carried = |i: usize| {
-            assembly.values_of_elements(table, |f| (&elements[f].0, &elements[f].1[i][..]))
-        };
-        let (k, d) = (assembly.matrix(carried(0)?), assembly.matrix(carried(1)?));
+        let [k, d] = assembly
+            .values_of_elements(table, |f| {
+                let (cols, [k, d]) = &elements[f];
+                (&cols[..], [&k[..], &d[..]])
+            })?
+            .map(|values| assembly.matrix(values));
         let mut kd_values: Vec<Real> = k
             .weights
             .iter()

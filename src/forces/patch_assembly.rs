@@ -216,30 +216,33 @@ impl PatchAssembly {
         Ok(values)
     }
 
-    /// `Σ_f S_fᵀ E_f S_f` in the pattern's order: the dense element
-    /// `element(f) = (cols, E_f)` of every patch `f` over level-`L`
-    /// vertices of its one-ring (`cols` sorted, `E_f` row-major), carried to
-    /// the control points through the patch's rows `S_f` of `S` — the
-    /// finite-element scatter and `Sᵀ K_L S` in one pass.
-    pub fn values_of_elements<'a>(
+    /// `Σ_f S_fᵀ E_f S_f` in the pattern's order, for each of `N` sets of
+    /// elements at once: the dense elements `element(f) = (cols, [E_f, …])`
+    /// of every patch `f` over level-`L` vertices of its one-ring (`cols`
+    /// sorted, each `E_f` row-major), carried to the control points through
+    /// the patch's rows `S_f` of `S` — the finite-element scatter and
+    /// `Sᵀ K_L S` in one pass.
+    pub fn values_of_elements<'a, const N: usize>(
         &self,
         table: &PatchTable,
-        element: impl Fn(usize) -> (&'a [u32], &'a [Real]) + Sync,
-    ) -> Result<Vec<Real>> {
+        element: impl Fn(usize) -> (&'a [u32], [&'a [Real]; N]) + Sync,
+    ) -> Result<[Vec<Real>; N]> {
         let s = table.to_level();
         let patches = self.ring_offsets.len() - 1;
         let chunk = patches.div_ceil(rayon::current_num_threads().max(1)).max(1);
-        let parts: Vec<Vec<Real>> = (0..patches)
+        let parts: Vec<[Vec<Real>; N]> = (0..patches)
             .collect::<Vec<_>>()
             .par_chunks(chunk)
             .map(|fs| {
-                let mut values = vec![0.0; self.indices.len()];
-                // `c`: the sum over the patches of `block` so far.
-                let (mut t, mut c, mut block) = (Vec::new(), Vec::new(), None);
+                let mut values: [Vec<Real>; N] =
+                    std::array::from_fn(|_| vec![0.0; self.indices.len()]);
+                // `c[k]`: the sum over the patches of `block` so far.
+                let mut c: [Vec<Real>; N] = std::array::from_fn(|_| Vec::new());
+                let (mut t, mut block) = (Vec::new(), None);
                 for &f in fs {
-                    let (cols, e) = element(f);
+                    let (cols, es) = element(f);
                     let m = cols.len();
-                    if e.len() != m * m {
+                    if let Some(e) = es.iter().find(|e| e.len() != m * m) {
                         return Err(Error::Input(format!(
                             "patch {f}'s element has {} entries for {m} columns",
                             e.len()
@@ -266,40 +269,54 @@ impl PatchAssembly {
                     let n = self.support_of_block(b).len();
                     if block != Some(b) {
                         if let Some(done) = block {
-                            self.scatter(done, &c, &mut values);
-                        }
-                        block = Some(b);
-                        c.clear();
-                        c.resize(n * n, 0.0);
-                    }
-                    // T = E S_f (m × n), then C += S_fᵀ T (n × n).
-                    t.clear();
-                    t.resize(m * n, 0.0);
-                    for (j, (w, at)) in rows.iter().enumerate() {
-                        for (&x, &b) in w.iter().zip(*at) {
-                            for i in 0..m {
-                                t[i * n + b as usize] += e[i * m + j] * x;
+                            for (c, v) in c.iter().zip(&mut values) {
+                                self.scatter(done, c, v);
                             }
                         }
+                        block = Some(b);
+                        for c in &mut c {
+                            c.clear();
+                            c.resize(n * n, 0.0);
+                        }
                     }
-                    for (i, (w, at)) in rows.iter().enumerate() {
-                        for (&x, &a) in w.iter().zip(*at) {
-                            let a = a as usize;
-                            for (o, &y) in
-                                c[a * n..(a + 1) * n].iter_mut().zip(&t[i * n..(i + 1) * n])
-                            {
-                                *o += x * y;
+                    for (e, c) in es.iter().zip(&mut c) {
+                        // T = E S_f (m × n), then C += S_fᵀ T (n × n).
+                        t.clear();
+                        t.resize(m * n, 0.0);
+                        for (j, (w, at)) in rows.iter().enumerate() {
+                            for (&x, &b) in w.iter().zip(*at) {
+                                for i in 0..m {
+                                    t[i * n + b as usize] += e[i * m + j] * x;
+                                }
+                            }
+                        }
+                        for (i, (w, at)) in rows.iter().enumerate() {
+                            for (&x, &a) in w.iter().zip(*at) {
+                                let a = a as usize;
+                                for (o, &y) in
+                                    c[a * n..(a + 1) * n].iter_mut().zip(&t[i * n..(i + 1) * n])
+                                {
+                                    *o += x * y;
+                                }
                             }
                         }
                     }
                 }
                 if let Some(done) = block {
-                    self.scatter(done, &c, &mut values);
+                    for (c, v) in c.iter().zip(&mut values) {
+                        self.scatter(done, c, v);
+                    }
                 }
                 Ok(values)
             })
             .collect::<Result<_>>()?;
-        Ok(summed(parts, self.indices.len()))
+        let mut sums: [Vec<Vec<Real>>; N] = std::array::from_fn(|_| Vec::new());
+        for part in parts {
+            for (s, v) in sums.iter_mut().zip(part) {
+                s.push(v);
+            }
+        }
+        Ok(sums.map(|s| summed(s, self.indices.len())))
     }
 
     /// The matrix with `values` in the pattern.

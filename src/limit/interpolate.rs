@@ -37,7 +37,8 @@ pub fn interpolate_limit_points(
             mesh.num_vertices()
         )));
     }
-    let h = Refiner::new(mesh, &RefineOptions::default())?.refine_uniform(0)?;
+    // One level more lets `limit_stencil` use masks at vertices of n-gons.
+    let h = Refiner::new(mesh, &RefineOptions::default())?.refine_uniform(1)?;
     let l = limit_stencil(&h, 0)?;
     let mut p = mesh.positions.clone();
     let mut lp = vec![Point3::origin(); p.len()];

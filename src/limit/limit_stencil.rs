@@ -1,9 +1,9 @@
 //! Limit positions of all vertices of a refinement level, as one stencil table.
 
 use crate::error::Result;
-use crate::stencil::StencilTable;
+use crate::stencil::{RowBuilder, StencilTable};
 use crate::subdivision::Hierarchy;
-use crate::topology::VertexRule;
+use crate::topology::{Level, Sharpness, VertexRule};
 
 use super::patch::{CORNERS, evaluate_face};
 use super::vertex_masks::{limit_position_mask, masks_apply};
@@ -11,15 +11,43 @@ use super::vertex_masks::{limit_position_mask, masks_apply};
 /// Rows = limit positions of the vertices of level `level`, as weights over
 /// the level-0 control points. Where the vertex masks apply (quads around the
 /// vertex, no semi-sharp feature at it, not a dart) the mask of
-/// `vertex_masks` is used; elsewhere the vertex is a corner of one of its faces and the limit point
+/// `vertex_masks` is used. Elsewhere, when `h` holds level `level + 1` and
+/// the masks apply to the vertex's vertex point there (one step turns
+/// n-gons into quads and lowers semi-sharpness by 1), the limit point is
+/// that child's, its mask carried back through the subdivision rows.
+/// Otherwise the vertex is a corner of one of its faces and the limit point
 /// is evaluated there by local subdivision, which follows semi-sharp creases
 /// until they have decayed.
 pub fn limit_stencil(h: &Hierarchy, level: usize) -> Result<StencilTable> {
     let (lv, sh) = (h.level(level), &h.sharpness[level]);
+    let masked = |lv: &Level, sh: &Sharpness, v: usize| {
+        lv.vertex_faces(v).is_empty()
+            || (masks_apply(lv, sh, v) && sh.rule(lv, v) != VertexRule::Dart)
+    };
+    let child = (level < h.num_levels()).then(|| {
+        (
+            h.level(level + 1),
+            &h.sharpness[level + 1],
+            h.stencil(level),
+            lv.num_faces() + lv.num_edges(),
+        )
+    });
     let rows = StencilTable::from_row_fn(lv.num_vertices, lv.num_vertices, |v, b| {
-        let dart = sh.rule(lv, v) == VertexRule::Dart;
-        if lv.vertex_faces(v).is_empty() || (masks_apply(lv, sh, v) && !dart) {
+        if masked(lv, sh, v) {
             limit_position_mask(lv, sh, v, 1.0, b);
+            return;
+        }
+        if let Some((l1, s1, step, first)) = child
+            && masked(l1, s1, first + v)
+        {
+            let mut mask = RowBuilder::default();
+            limit_position_mask(l1, s1, first + v, 1.0, &mut mask);
+            for (c, x) in mask.entries() {
+                let (cols, ws) = step.row(c as usize);
+                for (&c, &w) in cols.iter().zip(ws) {
+                    b.add(c, x * w);
+                }
+            }
             return;
         }
         let f = lv.vertex_faces(v)[0] as usize;
