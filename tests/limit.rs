@@ -1196,3 +1196,33 @@ fn shared_quadtree_cache_changes_no_evaluation() {
     }
     assert!(format!("{shared:?}").contains("structures"));
 }
+
+/// `PatchTable::position` is `eval`'s point, on regular patches, quadtree
+/// leaves and the innermost cell at an irregular vertex (`(0.004, 0.002)`).
+#[test]
+fn patch_position_equals_the_evaluated_point() {
+    for (mesh, name) in [
+        (pentagonal_pyramid(), "pentagonal pyramid"),
+        (mixed_mesh(), "mixed mesh"),
+        (subdyn::examples::cube(), "cube"),
+    ] {
+        let d = diag(&mesh.positions);
+        let table = PatchTable::new(&default_refiner(&mesh), &mesh.positions, 1).unwrap();
+        for f in 0..table.num_patches() {
+            for st in [
+                [0.5, 0.5],
+                [0.1, 0.7],
+                [0.004, 0.002],
+                [0.3, 0.0],
+                [1.0, 1.0],
+            ] {
+                let (p, e) = (table.position(f, st).unwrap(), table.eval(f, st).unwrap());
+                assert!(
+                    (p - e.p).norm() <= 1e-14 * d,
+                    "{name}: patch {f} at {st:?}: {p} against {}",
+                    e.p
+                );
+            }
+        }
+    }
+}

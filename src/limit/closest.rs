@@ -172,11 +172,7 @@ impl ClosestPointEngine {
         let pts: Vec<[Real; 3]> = self
             .seeds
             .par_iter()
-            .map(|&(f, st)| {
-                self.table
-                    .eval(f as usize, st)
-                    .map(|e| [e.p.x, e.p.y, e.p.z])
-            })
+            .map(|&(f, st)| self.table.position(f as usize, st).map(|p| [p.x, p.y, p.z]))
             .collect::<Result<_>>()?;
         Ok(self
             .tree

@@ -30,7 +30,7 @@ use crate::stencil::{RowBuilder, StencilTable};
 use crate::subdivision::{Hierarchy, Refiner};
 use crate::topology::{Level, Sharpness};
 
-use super::bspline::patch_weights;
+use super::bspline::{cubic_basis, patch_weights};
 use super::patch::{
     CORNERS, LocalPatch, SampleStencil, child_frame, evaluate_face, mat_mul, mat_vec, patch_grid,
     quadrant,
@@ -256,34 +256,18 @@ impl PatchTable {
 
     /// Evaluates patch `f` at `(s, t) ∈ [0, 1]²`.
     pub fn eval(&self, f: usize, st: [Real; 2]) -> Result<PatchPoint> {
+        match self.bicubic_piece(f, st) {
+            Some((grid, x, None)) => return Ok(bicubic(grid, x)),
+            Some((grid, x, Some(jac))) => {
+                let e = bicubic(grid, x);
+                return Ok(PatchPoint {
+                    p: e.p,
+                    d: chain(e.d, jac),
+                });
+            }
+            None => {}
+        }
         let patch = &self.patches[f];
-        if patch.regular {
-            let grid: &[Point3; 16] = self.grid_points[16 * f..16 * f + 16]
-                .try_into()
-                .expect("16 control points per patch");
-            return Ok(bicubic(grid, st));
-        }
-        let tree = patch.tree.get_or_init(|| self.tree(f));
-        if let Some((leaf, rows, x)) = tree.leaf_at(st) {
-            let cols = &tree.cols;
-            let nc = cols.len().max(1);
-            let grid = leaf.points.get_or_init(|| {
-                std::array::from_fn(|k| {
-                    Point3::from(
-                        rows[k * nc..(k + 1) * nc]
-                            .iter()
-                            .zip(cols)
-                            .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
-                            .sum::<Vector3>(),
-                    )
-                })
-            });
-            let e = bicubic(grid, x);
-            return Ok(PatchPoint {
-                p: e.p,
-                d: chain(e.d, leaf.jac),
-            });
-        }
         let s = self.sample(f, st);
         let e = self
             .evaluator
@@ -534,6 +518,62 @@ impl PatchTable {
         })
     }
 
+    /// The limit point of patch `f` at `(s, t)`: [`eval`](Self::eval)'s
+    /// position without the derivatives (a quarter of the work on a
+    /// bicubic piece).
+    pub fn position(&self, f: usize, st: [Real; 2]) -> Result<Point3> {
+        match self.bicubic_piece(f, st) {
+            Some((grid, x, _)) => {
+                let (bs, bt) = (cubic_basis(x[0])[0], cubic_basis(x[1])[0]);
+                Ok(Point3::from(
+                    (0..4)
+                        .map(|a| {
+                            bs[a]
+                                * (0..4)
+                                    .map(|b| bt[b] * grid[4 * a + b].coords)
+                                    .sum::<Vector3>()
+                        })
+                        .sum::<Vector3>(),
+                ))
+            }
+            None => Ok(self.eval(f, st)?.p),
+        }
+    }
+
+    /// The bicubic piece of patch `f` holding `(s, t)`: its 16 control points,
+    /// the point in its own parameters and, for a quadtree leaf, the
+    /// Jacobian of those; `None` in the innermost cell at an irregular
+    /// vertex.
+    fn bicubic_piece(
+        &self,
+        f: usize,
+        st: [Real; 2],
+    ) -> Option<(&[Point3; 16], [Real; 2], Option<[[Real; 2]; 2]>)> {
+        let patch = &self.patches[f];
+        if patch.regular {
+            let grid: &[Point3; 16] = self.grid_points[16 * f..16 * f + 16]
+                .try_into()
+                .expect("16 control points per patch");
+            return Some((grid, st, None));
+        }
+        let tree = patch.tree.get_or_init(|| self.tree(f));
+        let (leaf, rows, x) = tree.leaf_at(st)?;
+        let cols = &tree.cols;
+        let nc = cols.len().max(1);
+        let grid = leaf.points.get_or_init(|| {
+            std::array::from_fn(|k| {
+                Point3::from(
+                    rows[k * nc..(k + 1) * nc]
+                        .iter()
+                        .zip(cols)
+                        .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
+                        .sum::<Vector3>(),
+                )
+            })
+        });
+        Some((grid, x, Some(leaf.jac)))
+    }
+
     /// The quadtree of irregular level-`L` face `f` (see module docs).
     fn tree(&self, f: usize) -> Tree {
         let root = LocalPatch::around(&self.level, &self.sharp, f);
@@ -617,11 +657,22 @@ fn builders_to_stencil(b: &[RowBuilder; 6]) -> SampleStencil {
 
 /// Bicubic B-spline patch value and derivatives at `(s, t)`.
 fn bicubic(grid: &[Point3; 16], st: [Real; 2]) -> PatchPoint {
-    let w = patch_weights(st[0], st[1]);
-    let q: [Vector3; 6] = std::array::from_fn(|k| (0..16).map(|i| w[k][i] * grid[i].coords).sum());
+    // The weights of `patch_weights`, as a tensor product: first along `t`
+    // (`c[k][a]`, derivative order `k` in `t`), then along `s`.
+    let (bs, bt) = (cubic_basis(st[0]), cubic_basis(st[1]));
+    let c: [[Vector3; 4]; 3] = std::array::from_fn(|k| {
+        std::array::from_fn(|a| (0..4).map(|b| bt[k][b] * grid[4 * a + b].coords).sum())
+    });
+    let along = |ds: usize, dt: usize| -> Vector3 { (0..4).map(|a| bs[ds][a] * c[dt][a]).sum() };
     PatchPoint {
-        p: Point3::from(q[0]),
-        d: [q[1], q[2], q[3], q[4], q[5]],
+        p: Point3::from(along(0, 0)),
+        d: [
+            along(1, 0),
+            along(0, 1),
+            along(2, 0),
+            along(1, 1),
+            along(0, 2),
+        ],
     }
 }
 
