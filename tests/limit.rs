@@ -1198,7 +1198,9 @@ fn shared_quadtree_cache_changes_no_evaluation() {
 }
 
 /// `PatchTable::position` is `eval`'s point, on regular patches, quadtree
-/// leaves and the innermost cell at an irregular vertex (`(0.004, 0.002)`).
+/// leaves and the innermost cells at irregular vertices (within 1/64 of the
+/// corner, evaluated from the cell's local patch); there the point is the
+/// limit evaluator's and the first derivatives match central differences.
 #[test]
 fn patch_position_equals_the_evaluated_point() {
     for (mesh, name) in [
@@ -1207,7 +1209,9 @@ fn patch_position_equals_the_evaluated_point() {
         (subdyn::examples::cube(), "cube"),
     ] {
         let d = diag(&mesh.positions);
-        let table = PatchTable::new(&default_refiner(&mesh), &mesh.positions, 1).unwrap();
+        let r = default_refiner(&mesh);
+        let table = PatchTable::new(&r, &mesh.positions, 1).unwrap();
+        let eval = LimitEvaluator::new(&r);
         for f in 0..table.num_patches() {
             for st in [
                 [0.5, 0.5],
@@ -1222,6 +1226,35 @@ fn patch_position_equals_the_evaluated_point() {
                     "{name}: patch {f} at {st:?}: {p} against {}",
                     e.p
                 );
+            }
+            for st in [[0.004, 0.002], [0.002, 0.01], [0.996, 0.999], [0.0, 0.0]] {
+                let e = table.eval(f, st).unwrap();
+                let s = table.sample(f, st);
+                let exact = eval
+                    .evaluate(s.face as usize, s.u, s.v, &mesh.positions)
+                    .unwrap();
+                assert!(
+                    (e.p - exact.p).norm() <= 1e-12 * d,
+                    "{name}: patch {f} at {st:?}: {} against the evaluator's {}",
+                    e.p,
+                    exact.p
+                );
+                if st == [0.0, 0.0] {
+                    continue;
+                }
+                let h = 1e-7;
+                for (k, step) in [[h, 0.0], [0.0, h]].iter().enumerate() {
+                    let at = |sign: f64| {
+                        let q = [st[0] + sign * step[0], st[1] + sign * step[1]];
+                        table.position(f, q).unwrap()
+                    };
+                    let fd = (at(1.0) - at(-1.0)) / (2.0 * h);
+                    assert!(
+                        (fd - e.d[k]).norm() <= 1e-5 * e.d[k].norm().max(d),
+                        "{name}: patch {f} at {st:?}: derivative {k} {} against {fd}",
+                        e.d[k]
+                    );
+                }
             }
         }
     }

@@ -46,6 +46,7 @@ pub struct SampleStencil {
 
 /// A neighbourhood of one face, with every local vertex as a dense row of
 /// weights over `cols`.
+#[derive(Clone)]
 pub(crate) struct LocalPatch {
     pub(crate) level: Level,
     sharp: Sharpness,
@@ -275,6 +276,19 @@ pub fn evaluate_face(
         patch.descend(i);
         depth = 1;
     }
+    evaluate_local(patch, st, jac, depth)
+}
+
+/// [`evaluate_face`] from a quad `patch` already `depth` subdivisions below
+/// its base face, at its `(s, t)` = `st`; `jac` maps the caller's
+/// parameters to these (the derivatives are returned in the caller's).
+/// Weights are over `patch.cols`.
+pub(crate) fn evaluate_local(
+    mut patch: LocalPatch,
+    mut st: [Real; 2],
+    mut jac: [[Real; 2]; 2],
+    mut depth: usize,
+) -> SampleStencil {
     loop {
         let f = patch.face;
         let fv: Vec<u32> = patch.level.face_vertices(f as usize).to_vec();

@@ -32,8 +32,8 @@ use crate::topology::{Level, Sharpness};
 
 use super::bspline::{cubic_basis, patch_weights};
 use super::patch::{
-    CORNERS, LocalPatch, SampleStencil, child_frame, evaluate_face, mat_mul, mat_vec, patch_grid,
-    quadrant,
+    CORNERS, LocalPatch, SampleStencil, child_frame, evaluate_face, evaluate_local, mat_mul,
+    mat_vec, patch_grid, quadrant,
 };
 use super::vertex_masks::{CornerKind, corner_kind};
 use super::{LimitEvaluator, LimitPoint, Sample};
@@ -67,30 +67,51 @@ impl Tree {
     /// innermost cell at the irregular vertex.
     fn leaf_at(&self, st: [Real; 2]) -> Option<(&Leaf, &[Real], [Real; 2])> {
         self.leaves.iter().find_map(|leaf| {
-            let x = [
-                leaf.jac[0][0] * st[0] + leaf.jac[0][1] * st[1] + leaf.off[0],
-                leaf.jac[1][0] * st[0] + leaf.jac[1][1] * st[1] + leaf.off[1],
-            ];
-            let inside = x.iter().all(|c| (-1e-12..=1.0 + 1e-12).contains(c));
-            match (&leaf.grid, inside) {
-                (Some(rows), true) => Some((leaf, &rows[..], x.map(|c| c.clamp(0.0, 1.0)))),
-                _ => None,
-            }
+            let x = leaf.local(st)?;
+            Some((leaf, &leaf.grid.as_ref()?[..], x))
         })
+    }
+
+    /// The innermost cell holding `(s, t)` (where [`leaf_at`](Self::leaf_at)
+    /// finds none), and the point in its `(s', t')`.
+    fn cell_at(&self, st: [Real; 2]) -> Option<(&Leaf, &LocalPatch, [Real; 2])> {
+        self.leaves.iter().find_map(|leaf| {
+            let x = leaf.local(st)?;
+            Some((leaf, &**leaf.cell.as_ref()?, x))
+        })
+    }
+}
+
+impl Leaf {
+    /// `(s', t')` of the face's `(s, t)`, clamped to the unit square, if in
+    /// this cell.
+    fn local(&self, st: [Real; 2]) -> Option<[Real; 2]> {
+        let x = [
+            self.jac[0][0] * st[0] + self.jac[0][1] * st[1] + self.off[0],
+            self.jac[1][0] * st[0] + self.jac[1][1] * st[1] + self.off[1],
+        ];
+        x.iter()
+            .all(|c| (-1e-12..=1.0 + 1e-12).contains(c))
+            .then(|| x.map(|c| c.clamp(0.0, 1.0)))
     }
 }
 
 /// A cell of an irregular face's quadtree: leaf `(s', t') = J (s, t) + c`
 /// in the face's `(s, t)`, with its 16 bicubic control points as rows over
 /// the tree's `cols`, one after the other (`None` for the innermost cell at an
-/// irregular vertex, evaluated exactly).
+/// irregular vertex, evaluated exactly from its local patch, `cell`).
 struct Leaf {
     jac: [[Real; 2]; 2],
     off: [Real; 2],
     grid: Option<Arc<Vec<Real>>>,
+    cell: Option<Arc<LocalPatch>>,
     /// The control points at the current positions (cleared by `set_positions`).
     points: OnceLock<[Point3; 16]>,
 }
+
+/// A bicubic piece's control points, the point in the piece's own
+/// parameters and, for a quadtree leaf, their Jacobian.
+type BicubicPiece<'a> = (&'a [Point3; 16], [Real; 2], Option<[[Real; 2]; 2]>);
 
 /// Position and derivatives `∂s, ∂t, ∂ss, ∂st, ∂tt` in a patch's own `(s, t)`.
 #[derive(Clone, Copy, Debug)]
@@ -268,6 +289,27 @@ impl PatchTable {
             None => {}
         }
         let patch = &self.patches[f];
+        // The innermost cell at the irregular vertex: exact evaluation from
+        // the cell's local patch (its weights are over the tree's columns,
+        // in order). Exactly at a corner the evaluator's corner tangents
+        // (which depend on the depth they are taken at) are kept.
+        if let Some(tree) = patch.tree.get()
+            && let Some((leaf, cell, x)) = tree.cell_at(st)
+            && !CORNERS.contains(&x)
+        {
+            let s = evaluate_local(cell.clone(), x, [[1.0, 0.0], [0.0, 1.0]], TREE_DEPTH);
+            let q: [Vector3; 6] = std::array::from_fn(|k| {
+                s.weights[k]
+                    .iter()
+                    .zip(&tree.cols)
+                    .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
+                    .sum()
+            });
+            return Ok(PatchPoint {
+                p: Point3::from(q[0]),
+                d: chain([q[1], q[2], q[3], q[4], q[5]], leaf.jac),
+            });
+        }
         let s = self.sample(f, st);
         let e = self
             .evaluator
@@ -544,11 +586,7 @@ impl PatchTable {
     /// the point in its own parameters and, for a quadtree leaf, the
     /// Jacobian of those; `None` in the innermost cell at an irregular
     /// vertex.
-    fn bicubic_piece(
-        &self,
-        f: usize,
-        st: [Real; 2],
-    ) -> Option<(&[Point3; 16], [Real; 2], Option<[[Real; 2]; 2]>)> {
+    fn bicubic_piece(&self, f: usize, st: [Real; 2]) -> Option<BicubicPiece<'_>> {
         let patch = &self.patches[f];
         if patch.regular {
             let grid: &[Point3; 16] = self.grid_points[16 * f..16 * f + 16]
@@ -593,6 +631,7 @@ impl PatchTable {
                 jac: l.jac,
                 off: l.off,
                 grid: l.grid.clone(),
+                cell: l.cell.clone(),
                 points: OnceLock::new(),
             })
             .collect();
@@ -609,6 +648,7 @@ impl PatchTable {
                     jac,
                     off,
                     grid: None,
+                    cell: Some(Arc::new(patch)),
                     points: OnceLock::new(),
                 });
                 continue;
@@ -624,6 +664,7 @@ impl PatchTable {
                         jac: cj,
                         off: co,
                         grid: Some(Arc::new(refined.grid_rows(cf))),
+                        cell: None,
                         points: OnceLock::new(),
                     });
                 } else {
