@@ -368,8 +368,14 @@ impl ClosestPointEngine {
             if step == [0.0, 0.0] {
                 return Ok((f, st, e, true));
             }
-            // Limit the step to half a patch.
+            // A step shorter than the tolerance would move the point by
+            // less than that (the distance, stationary here, by its square):
+            // settled without evaluating there.
             let len = (step[0] * step[0] + step[1] * step[1]).sqrt();
+            if len < tol {
+                return Ok((f, st, e, true));
+            }
+            // Limit the step to half a patch.
             if len > 0.5 {
                 step = [step[0] * 0.5 / len, step[1] * 0.5 / len];
             }
