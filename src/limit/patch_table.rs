@@ -5,10 +5,11 @@
 //! points, which is exactly the limit surface over that face. A face that
 //! touches an irregular vertex is, on first use, subdivided locally into a
 //! quadtree of regular bicubic leaves [`TREE_DEPTH`] levels deep; only the
-//! innermost cell at the irregular vertex is evaluated through
-//! [`LimitEvaluator`] (OpenSubdiv's feature-adaptive patch tables rest on the
-//! same observation, Nießner et al. 2012). Evaluation is then a 16-point
-//! product almost everywhere.
+//! innermost cell at the irregular vertex is evaluated exactly, by further
+//! local subdivision from the cell's own (cached) local patch, and the
+//! vertex itself through [`LimitEvaluator`] (OpenSubdiv's feature-adaptive
+//! patch tables rest on the same observation, Nießner et al. 2012).
+//! Evaluation is then a 16-point product almost everywhere.
 //!
 //! Everything but the positions is built once: the patches' control points
 //! are one stencil table over the level-`L` vertices, and the quadtree leaves
