@@ -59,17 +59,21 @@ struct Patch {
 /// rows of weights over the level-`L` vertices `cols` (the face's 1-ring).
 struct Tree {
     cols: Vec<u32>,
-    leaves: Vec<Leaf>,
+    /// The leaves, shared by the faces of one structure.
+    leaves: Arc<Vec<Leaf>>,
+    /// Each leaf's control points at the current positions, made on first
+    /// use (cleared by `set_positions`).
+    points: Vec<OnceLock<Box<[Point3; 16]>>>,
 }
 
 impl Tree {
     /// The regular leaf holding `(s, t)`, its grid rows and the point in the
     /// leaf's own `(s', t')` (clamped to the unit square); `None` in the
     /// innermost cell at the irregular vertex.
-    fn leaf_at(&self, st: [Real; 2]) -> Option<(&Leaf, &[Real], [Real; 2])> {
-        self.leaves.iter().find_map(|leaf| {
+    fn leaf_at(&self, st: [Real; 2]) -> Option<(usize, &Leaf, &[Real], [Real; 2])> {
+        self.leaves.iter().enumerate().find_map(|(i, leaf)| {
             let x = leaf.local(st)?;
-            Some((leaf, &leaf.grid.as_ref()?[..], x))
+            Some((i, leaf, &leaf.grid.as_ref()?[..], x))
         })
     }
 
@@ -78,7 +82,7 @@ impl Tree {
     fn cell_at(&self, st: [Real; 2]) -> Option<(&Leaf, &LocalPatch, [Real; 2])> {
         self.leaves.iter().find_map(|leaf| {
             let x = leaf.local(st)?;
-            Some((leaf, &**leaf.cell.as_ref()?, x))
+            Some((leaf, leaf.cell.as_ref()?, x))
         })
     }
 }
@@ -104,10 +108,8 @@ impl Leaf {
 struct Leaf {
     jac: [[Real; 2]; 2],
     off: [Real; 2],
-    grid: Option<Arc<Vec<Real>>>,
-    cell: Option<Arc<LocalPatch>>,
-    /// The control points at the current positions (cleared by `set_positions`).
-    points: OnceLock<[Point3; 16]>,
+    grid: Option<Vec<Real>>,
+    cell: Option<LocalPatch>,
 }
 
 /// A bicubic piece's control points, the point in the piece's own
@@ -252,8 +254,8 @@ impl PatchTable {
         self.grid_points = self.grid_table.apply(&self.level_positions)?;
         for patch in &mut self.patches {
             if let Some(tree) = patch.tree.get_mut() {
-                for leaf in &mut tree.leaves {
-                    leaf.points = OnceLock::new();
+                for points in &mut tree.points {
+                    points.take();
                 }
             }
         }
@@ -374,7 +376,7 @@ impl PatchTable {
     /// The stencil at `(s, t)` of irregular patch `f` from its quadtree.
     fn tree_stencil(&self, tree: &Tree, f: usize, st: [Real; 2]) -> SampleStencil {
         let nc = tree.cols.len();
-        if let Some((leaf, rows, x)) = tree.leaf_at(st) {
+        if let Some((_, leaf, rows, x)) = tree.leaf_at(st) {
             let w = patch_weights(x[0], x[1]);
             let local: [Vec<Real>; 6] = std::array::from_fn(|q| {
                 let mut out = vec![0.0; nc];
@@ -434,7 +436,7 @@ impl PatchTable {
         }
         let tree = patch.tree.get_or_init(|| self.tree(f));
         let nc = tree.cols.len();
-        if let Some((_, rows, x)) = tree.leaf_at(st) {
+        if let Some((_, _, rows, x)) = tree.leaf_at(st) {
             let [w, ..] = patch_weights(x[0], x[1]);
             for (k, &c) in tree.cols.iter().enumerate() {
                 visit(c, (0..16).map(|i| w[i] * rows[i * nc + k]).sum());
@@ -596,11 +598,11 @@ impl PatchTable {
             return Some((grid, st, None));
         }
         let tree = patch.tree.get_or_init(|| self.tree(f));
-        let (leaf, rows, x) = tree.leaf_at(st)?;
+        let (i, leaf, rows, x) = tree.leaf_at(st)?;
         let cols = &tree.cols;
         let nc = cols.len().max(1);
-        let grid = leaf.points.get_or_init(|| {
-            std::array::from_fn(|k| {
+        let grid = tree.points[i].get_or_init(|| {
+            Box::new(std::array::from_fn(|k| {
                 Point3::from(
                     rows[k * nc..(k + 1) * nc]
                         .iter()
@@ -608,7 +610,7 @@ impl PatchTable {
                         .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
                         .sum::<Vector3>(),
                 )
-            })
+            }))
         });
         Some((grid, x, Some(leaf.jac)))
     }
@@ -626,17 +628,11 @@ impl PatchTable {
             }
             shape
         });
-        let leaves = shape
-            .iter()
-            .map(|l| Leaf {
-                jac: l.jac,
-                off: l.off,
-                grid: l.grid.clone(),
-                cell: l.cell.clone(),
-                points: OnceLock::new(),
-            })
-            .collect();
-        Tree { cols, leaves }
+        Tree {
+            cols,
+            points: shape.iter().map(|_| OnceLock::new()).collect(),
+            leaves: shape,
+        }
     }
 
     /// The quadtree leaves of local patch `root` (weights over its `cols`).
@@ -649,8 +645,7 @@ impl PatchTable {
                     jac,
                     off,
                     grid: None,
-                    cell: Some(Arc::new(patch)),
-                    points: OnceLock::new(),
+                    cell: Some(patch),
                 });
                 continue;
             }
@@ -664,9 +659,8 @@ impl PatchTable {
                     leaves.push(Leaf {
                         jac: cj,
                         off: co,
-                        grid: Some(Arc::new(refined.grid_rows(cf))),
+                        grid: Some(refined.grid_rows(cf)),
                         cell: None,
-                        points: OnceLock::new(),
                     });
                 } else {
                     stack.push((refined.extract(cf), cj, co, depth + 1));
