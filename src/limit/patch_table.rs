@@ -280,16 +280,12 @@ impl PatchTable {
 
     /// Evaluates patch `f` at `(s, t) ∈ [0, 1]²`.
     pub fn eval(&self, f: usize, st: [Real; 2]) -> Result<PatchPoint> {
-        match self.bicubic_piece(f, st) {
-            Some((grid, x, None)) => return Ok(bicubic(grid, x)),
-            Some((grid, x, Some(jac))) => {
-                let e = bicubic(grid, x);
-                return Ok(PatchPoint {
-                    p: e.p,
-                    d: chain(e.d, jac),
-                });
-            }
-            None => {}
+        if let Some((grid, x, jac)) = self.bicubic_piece(f, st) {
+            let e = bicubic(grid, x);
+            return Ok(PatchPoint {
+                p: e.p,
+                d: jac.map_or(e.d, |j| chain(e.d, j)),
+            });
         }
         let patch = &self.patches[f];
         // The innermost cell at the irregular vertex: exact evaluation from
