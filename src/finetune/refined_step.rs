@@ -15,24 +15,26 @@ use crate::math::Real;
 
 use super::sparse_cholesky::{Cholesky, CholeskyPattern};
 
-/// Convergence: `|b − A x| ≤ RELATIVE_RESIDUAL · |b|`, `1e-10` (a direct
-/// solve of these systems leaves about `1e-13`).
+/// The tightest convergence asked of a step: `|b − A x| ≤ RELATIVE_RESIDUAL
+/// · |b|`, `1e-10` (a direct solve of these systems leaves about `1e-13`).
 pub const RELATIVE_RESIDUAL: Real = 1e-10;
 
 /// The solution of `A x = b`, `A` given by `values` in `pattern`'s slots,
 /// by conjugate gradients preconditioned by `factor` (of another matrix of
-/// the same pattern), with at most `max_iterations` iterations; `None` if
-/// it did not converge or met a direction of non-positive curvature. The
+/// the same pattern), to `|b − A x| ≤ relative · |b|` (`relative` at least
+/// [`RELATIVE_RESIDUAL`]) with at most `max_iterations` iterations; `None`
+/// if it did not converge or met a direction of non-positive curvature. The
 /// second value is the number of iterations done.
 pub fn preconditioned_solution(
     pattern: &CholeskyPattern,
     values: &[Real],
     factor: &Cholesky<'_>,
     b: &[Real],
+    relative: Real,
     max_iterations: usize,
 ) -> (Option<Vec<Real>>, usize) {
     let dot = |u: &[Real], v: &[Real]| u.iter().zip(v).map(|(a, b)| a * b).sum::<Real>();
-    let target = RELATIVE_RESIDUAL * dot(b, b).sqrt();
+    let target = relative.max(RELATIVE_RESIDUAL) * dot(b, b).sqrt();
     let mut x = vec![0.0; b.len()];
     let mut r = b.to_vec();
     let mut z = factor.solution(&r);

@@ -57,9 +57,22 @@ impl<'a> SurfacePointProblem<'a> {
         x
     }
 
-    /// Appends residual `r` with vertex gradients `(vertex, ∂r/∂x)`.
+    /// Appends residual `r` with vertex gradients `(vertex, ∂r/∂x)`; the
+    /// gradients of a vertex named twice (a joint's shared vertex) are
+    /// summed, so that a row names each variable once.
     fn push(&self, out: &mut Residuals, r: Real, grads: &[(u32, Vector3)]) {
+        let mut merged = [(0, Vector3::zeros()); 4];
+        let mut count = 0;
         for &(v, g) in grads {
+            match merged[..count].iter_mut().find(|e| e.0 == v) {
+                Some(e) => e.1 += g,
+                None => {
+                    merged[count] = (v, g);
+                    count += 1;
+                }
+            }
+        }
+        for &(v, g) in &merged[..count] {
             if let Some(base) = self.var_of[v as usize] {
                 out.vars.extend_from_slice(&[base, base + 1, base + 2]);
                 out.grads.extend_from_slice(&[g.x, g.y, g.z]);
