@@ -21,6 +21,8 @@ pub struct SurfacePointProblem<'a> {
     start: &'a [Point3],
     /// First variable of each vertex; `None` for a fixed vertex.
     var_of: Vec<Option<usize>>,
+    /// Each joint's distinct free vertices.
+    joint_layouts: Vec<JointLayout>,
     /// Jacobi scaling `s_v` per free vertex, for the reported gradient norm.
     scale: &'a [Real],
     free: &'a [usize],
@@ -39,10 +41,16 @@ impl<'a> SurfacePointProblem<'a> {
         for (k, &v) in free.iter().enumerate() {
             var_of[v] = Some(3 * k);
         }
+        let joint_layouts = energy
+            .joints
+            .iter()
+            .map(|j| JointLayout::new(j, &var_of))
+            .collect();
         SurfacePointProblem {
             energy,
             start,
             var_of,
+            joint_layouts,
             scale,
             free,
         }
@@ -57,26 +65,67 @@ impl<'a> SurfacePointProblem<'a> {
         x
     }
 
-    /// Appends residual `r` with vertex gradients `(vertex, ∂r/∂x)`; the
-    /// gradients of a vertex named twice (a joint's shared vertex) are
-    /// summed, so that a row names each variable once.
+    /// Appends residual `r` with vertex gradients `(vertex, ∂r/∂x)`.
     fn push(&self, out: &mut Residuals, r: Real, grads: &[(u32, Vector3)]) {
-        let mut merged = [(0, Vector3::zeros()); 4];
-        let mut count = 0;
         for &(v, g) in grads {
-            match merged[..count].iter_mut().find(|e| e.0 == v) {
-                Some(e) => e.1 += g,
-                None => {
-                    merged[count] = (v, g);
-                    count += 1;
-                }
+            if let Some(base) = self.var_of[v as usize] {
+                push_vertex(out, base, &g);
             }
         }
-        for &(v, g) in &merged[..count] {
-            if let Some(base) = self.var_of[v as usize] {
-                out.vars.extend_from_slice(&[base, base + 1, base + 2]);
-                out.grads.extend_from_slice(&[g.x, g.y, g.z]);
+        out.values.push(r);
+        out.start.push(out.vars.len());
+    }
+}
+
+/// Appends the gradient `g` of a vertex whose first variable is `base`.
+fn push_vertex(out: &mut Residuals, base: usize, g: &Vector3) {
+    out.vars.extend_from_slice(&[base, base + 1, base + 2]);
+    out.grads.extend_from_slice(&[g.x, g.y, g.z]);
+}
+
+/// A joint `[j₀, j₁, j₂, j₃]` as its distinct free vertices: a joint names
+/// its shared vertex twice (`j₁ = j₂` or `j₀ = j₂`), and its rows name each
+/// variable once, with that vertex's two gradients summed.
+struct JointLayout {
+    /// First variable of each distinct free vertex.
+    bases: [usize; 4],
+    /// How many of `bases` are used.
+    count: usize,
+    /// Index into `bases` of each `jᵢ`; `None` for a fixed vertex.
+    slot: [Option<usize>; 4],
+}
+
+impl JointLayout {
+    fn new(joint: &[u32; 4], var_of: &[Option<usize>]) -> Self {
+        let mut layout = JointLayout {
+            bases: [0; 4],
+            count: 0,
+            slot: [None; 4],
+        };
+        for (i, &v) in joint.iter().enumerate() {
+            let Some(base) = var_of[v as usize] else {
+                continue;
+            };
+            let found = layout.bases[..layout.count].iter().position(|&b| b == base);
+            layout.slot[i] = Some(found.unwrap_or_else(|| {
+                layout.bases[layout.count] = base;
+                layout.count += 1;
+                layout.count - 1
+            }));
+        }
+        layout
+    }
+
+    /// Appends residual `r` whose gradients with respect to `x[jᵢ]` are `grads[i]`.
+    fn push(&self, out: &mut Residuals, r: Real, grads: [Vector3; 4]) {
+        let mut summed = [Vector3::zeros(); 4];
+        for (slot, g) in self.slot.iter().zip(&grads) {
+            if let Some(s) = slot {
+                summed[*s] += g;
             }
+        }
+        for (base, g) in self.bases.iter().zip(&summed).take(self.count) {
+            push_vertex(out, *base, g);
         }
         out.values.push(r);
         out.start.push(out.vars.len());
@@ -114,17 +163,11 @@ impl LeastSquares for SurfacePointProblem<'_> {
             let w = x[j[3] as usize] - x[j[2] as usize];
             let (theta, gu, gw) = angle_and_gradients(&u, &w);
             let s = e.joint_weights[k].sqrt();
-            let rows = |gu: Vector3, gw: Vector3| {
-                [
-                    (j[1], gu * s),
-                    (j[0], -gu * s),
-                    (j[3], gw * s),
-                    (j[2], -gw * s),
-                ]
-            };
-            self.push(out, s * (theta - e.rest_angles[k]), &rows(gu, gw));
+            let rows = |gu: Vector3, gw: Vector3| [-gu * s, gu * s, -gw * s, gw * s];
+            let layout = &self.joint_layouts[k];
+            layout.push(out, s * (theta - e.rest_angles[k]), rows(gu, gw));
             for (du, dw) in transverse_rows(&u, &w, theta, e.rest_angles[k]) {
-                self.push(out, 0.0, &rows(du, dw));
+                layout.push(out, 0.0, rows(du, dw));
             }
         }
     }
