@@ -29,8 +29,14 @@ fn random_groups(rng: &mut Rng, n: usize) -> Vec<Vec<usize>> {
 
 /// Checks the factor of the random sparse SPD matrix `Σ_g v_g v_gᵀ + I`
 /// over `groups` against a dense product, and that a negative diagonal is
-/// refused.
-fn random_system(rng: &mut Rng, n: usize, node_of: &[usize], groups: &[Vec<usize>]) {
+/// refused (at every `refuse_every`-th unknown). Returns the pattern.
+fn random_system(
+    rng: &mut Rng,
+    n: usize,
+    node_of: &[usize],
+    groups: &[Vec<usize>],
+    refuse_every: usize,
+) -> CholeskyPattern {
     let weights: Vec<Vec<f64>> = groups
         .iter()
         .map(|g| g.iter().map(|_| rng.uniform(-1.0, 1.0)).collect())
@@ -94,9 +100,12 @@ fn random_system(rng: &mut Rng, n: usize, node_of: &[usize], groups: &[Vec<usize
         residual.norm()
     );
     // The same values with a strongly negative diagonal entry are refused.
-    let mut bad = values.clone();
-    bad[slots[s]] -= 1e6;
-    assert!(pattern.factor(&bad).is_none());
+    for i in (0..n).step_by(refuse_every) {
+        let mut bad = values.clone();
+        bad[slots[s + i]] -= 1e6;
+        assert!(pattern.factor(&bad).is_none(), "unknown {i}");
+    }
+    pattern
 }
 
 #[test]
@@ -107,12 +116,12 @@ fn sparse_cholesky_solves_random_spd_systems() {
         for size in [1, 2, 3, 5] {
             let node_of: Vec<usize> = (0..n).map(|i| i / size).collect();
             let groups = random_groups(&mut rng, n);
-            random_system(&mut rng, n, &node_of, &groups);
+            random_system(&mut rng, n, &node_of, &groups, n);
         }
         // Nodes in scrambled order.
         let node_of: Vec<usize> = (0..n).map(|i| (i * 7) % 5).collect();
         let groups = random_groups(&mut rng, n);
-        random_system(&mut rng, n, &node_of, &groups);
+        random_system(&mut rng, n, &node_of, &groups, n);
     }
 }
 
@@ -139,7 +148,11 @@ fn sparse_cholesky_solves_a_grid_system_ordered_by_nested_dissection() {
             }
         }
     }
-    random_system(&mut rng, n, &node_of, &groups);
+    // 600 blocks: split between two threads at the first separator, and
+    // the failure of a pivot in either part or in the separator is seen.
+    let pattern = random_system(&mut rng, n, &node_of, &groups, 7);
+    let (a, b) = pattern.parallel_parts().expect("split in two parts");
+    assert!(a > 100 && b > 100, "parts of {a} and {b} blocks");
 }
 
 /// `r = (z_0 − 1, 10 (z_1 − z_0²), z_2 − z_1)`: Rosenbrock plus a chain, minimum 0 at (1, 1, 1).

@@ -18,8 +18,11 @@ use super::min_degree::min_degree;
 pub const LEAF: usize = 64;
 
 /// An elimination order (a permutation of `0 … n − 1`) of the graph with
-/// adjacency lists `adj` (symmetric, without self loops).
-pub fn nested_dissection(adj: &[Vec<usize>]) -> Vec<usize> {
+/// adjacency lists `adj` (symmetric, without self loops), and the sizes
+/// `(a, b)` of the first split: the order is part A (`a` nodes), then part B
+/// (`b` nodes), then the separator, and no edge joins A and B; `None` when
+/// the graph was ordered whole.
+pub fn nested_dissection(adj: &[Vec<usize>]) -> (Vec<usize>, Option<(usize, usize)>) {
     let n = adj.len();
     let mut order = Vec::with_capacity(n);
     let mut part_of = vec![usize::MAX; n];
@@ -28,6 +31,7 @@ pub fn nested_dissection(adj: &[Vec<usize>]) -> Vec<usize> {
     // A stack: a part pushes its separator, then side B, then side A, so that
     // A is ordered first, then B, then the separator.
     let mut work = vec![Item::Part((0..n).collect())];
+    let mut split = None;
     while let Some(item) = work.pop() {
         let part = match item {
             Item::Emit(nodes) => {
@@ -57,6 +61,9 @@ pub fn nested_dissection(adj: &[Vec<usize>]) -> Vec<usize> {
                 .filter(|&v| level[v] == usize::MAX)
                 .collect();
             reset(&reached, &mut level);
+            if id == 0 {
+                split = Some((reached.len(), rest.len()));
+            }
             work.push(Item::Part(rest));
             work.push(Item::Part(reached));
             continue;
@@ -82,11 +89,15 @@ pub fn nested_dissection(adj: &[Vec<usize>]) -> Vec<usize> {
                 .map(|(&v, _)| v)
                 .collect()
         };
+        let (before, after) = (pick(|l, m| l < m), pick(|l, m| l > m));
+        if id == 0 {
+            split = Some((before.len(), after.len()));
+        }
         work.push(Item::Emit(pick(|l, m| l == m)));
-        work.push(Item::Part(pick(|l, m| l > m)));
-        work.push(Item::Part(pick(|l, m| l < m)));
+        work.push(Item::Part(after));
+        work.push(Item::Part(before));
     }
-    order
+    (order, split)
 }
 
 /// Clears the levels of `nodes`.
