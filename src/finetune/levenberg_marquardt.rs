@@ -112,7 +112,9 @@ pub trait LeastSquares {
     fn nodes(&self) -> Vec<usize>;
     /// `E(z) = Σ r_k²`.
     fn energy(&self, z: &[Real]) -> Real;
-    /// The residuals and their gradients at `z`, into `out` (cleared first).
+    /// The residuals and their gradients at `z`, into `out`, which is empty
+    /// or holds this problem's rows from an earlier call (an implementation
+    /// may keep their variables and rewrite only values and gradients).
     fn residuals(&self, z: &[Real], out: &mut Residuals);
     /// The gradient norm compared with the tolerance, given `∇E(z)`; by
     /// default `|∇E|`.
@@ -241,12 +243,14 @@ pub fn levenberg_marquardt<P: LeastSquares>(problem: &P, z0: &[Real], params: &L
             }
         }
     }
-    let mut local: Vec<Real> = Vec::new();
     let (pattern, slots) = CholeskyPattern::new(n, &problem.nodes(), &groups);
     timings.symbolic += lap(&mut clock);
     let diag_slots = &slots[slots.len() - n..];
-    let mut h = vec![0.0; pattern.num_values()];
-    let mut g = vec![0.0; n];
+    let (mut h, mut h2) = (
+        vec![0.0; pattern.num_values()],
+        vec![0.0; pattern.num_values()],
+    );
+    let (mut g, mut g2) = (vec![0.0; n], vec![0.0; n]);
     let mut run = LmRun {
         z: Vec::new(),
         energies: Vec::new(),
@@ -261,47 +265,16 @@ pub fn levenberg_marquardt<P: LeastSquares>(problem: &P, z0: &[Real], params: &L
     // The last numeric factor, the preconditioner of later steps.
     let mut previous = None;
     loop {
-        // E, g = 2 Jᵀr and H = 2 JᵀJ at z.
-        h.iter_mut().for_each(|v| *v = 0.0);
-        g.iter_mut().for_each(|v| *v = 0.0);
-        let mut e = 0.0;
-        for &(first, end, first_slot) in &runs {
-            let vars = &rows.vars[rows.start[first]..rows.start[first + 1]];
-            let m = vars.len();
-            local.clear();
-            local.resize(m * (m + 1) / 2, 0.0);
-            let mut used = false;
-            for k in first..end {
-                let r = rows.values[k];
-                e += r * r;
-                let grads = &rows.grads[rows.start[k]..rows.start[k + 1]];
-                if r == 0.0 && grads.iter().all(|&x| x == 0.0) {
-                    // An unused curvature row: nothing to add.
-                    continue;
-                }
-                used = true;
-                let mut t = 0;
-                for (p, (&a, &ga)) in vars.iter().zip(grads).enumerate() {
-                    g[a] += 2.0 * r * ga;
-                    for &gb in &grads[p..] {
-                        local[t] += ga * gb;
-                        t += 1;
-                    }
-                }
-            }
-            if !used {
-                continue;
-            }
-            let mut t = 0;
-            for (p, &a) in vars.iter().enumerate() {
-                for (q, &b) in vars.iter().enumerate().skip(p) {
-                    // A variable repeated in a row: its cross term stands for both orders.
-                    let twice = if q != p && a == b { 2.0 } else { 1.0 };
-                    h[slots[first_slot + t]] += 2.0 * local[t] * twice;
-                    t += 1;
-                }
-            }
-        }
+        // E, g = 2 Jᵀr and H = 2 JᵀJ at z: the two halves of the runs on
+        // two threads, the second into its own arrays, added after.
+        let (first_half, second_half) = runs.split_at(runs.len() / 2);
+        let (e1, e2) = rayon::join(
+            || accumulate(&rows, first_half, &slots, &mut h, &mut g),
+            || accumulate(&rows, second_half, &slots, &mut h2, &mut g2),
+        );
+        let e = e1 + e2;
+        h.iter_mut().zip(&h2).for_each(|(a, b)| *a += b);
+        g.iter_mut().zip(&g2).for_each(|(a, b)| *a += b);
         let gnorm = problem.gradient_norm(&z, &g);
         timings.assembly += lap(&mut clock);
         run.energies.push(e);
@@ -407,6 +380,61 @@ pub fn levenberg_marquardt<P: LeastSquares>(problem: &P, z0: &[Real], params: &L
     run.z = z;
     run.timings = timings;
     run
+}
+
+/// Sets `h` to `Σ 2 JₖᵀJₖ` (in the factor's `slots`) and `g` to `Σ 2 rₖ Jₖ`
+/// over the rows of `runs` (each `(first row, end, first slot)`: rows with
+/// the same variables, whose `JᵀJ` is summed densely before it is
+/// scattered); returns `Σ rₖ²`.
+fn accumulate(
+    rows: &Residuals,
+    runs: &[(usize, usize, usize)],
+    slots: &[usize],
+    h: &mut [Real],
+    g: &mut [Real],
+) -> Real {
+    h.iter_mut().for_each(|v| *v = 0.0);
+    g.iter_mut().for_each(|v| *v = 0.0);
+    let mut local: Vec<Real> = Vec::new();
+    let mut e = 0.0;
+    for &(first, end, first_slot) in runs {
+        let vars = &rows.vars[rows.start[first]..rows.start[first + 1]];
+        let m = vars.len();
+        local.clear();
+        local.resize(m * (m + 1) / 2, 0.0);
+        let mut used = false;
+        for k in first..end {
+            let r = rows.values[k];
+            e += r * r;
+            let grads = &rows.grads[rows.start[k]..rows.start[k + 1]];
+            if r == 0.0 && grads.iter().all(|&x| x == 0.0) {
+                // An unused curvature row: nothing to add.
+                continue;
+            }
+            used = true;
+            let mut t = 0;
+            for (p, (&a, &ga)) in vars.iter().zip(grads).enumerate() {
+                g[a] += 2.0 * r * ga;
+                for &gb in &grads[p..] {
+                    local[t] += ga * gb;
+                    t += 1;
+                }
+            }
+        }
+        if !used {
+            continue;
+        }
+        let mut t = 0;
+        for (p, &a) in vars.iter().enumerate() {
+            for (q, &b) in vars.iter().enumerate().skip(p) {
+                // A variable repeated in a row: its cross term stands for both orders.
+                let twice = if q != p && a == b { 2.0 } else { 1.0 };
+                h[slots[first_slot + t]] += 2.0 * local[t] * twice;
+                t += 1;
+            }
+        }
+    }
+    e
 }
 
 /// Seconds since `clock`, restarting it.

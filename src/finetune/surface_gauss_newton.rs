@@ -9,6 +9,8 @@
 //! joints are straight at rest, where Gauss-Newton alone has no stiffness
 //! across the loop's plane). Fixed vertices carry no variables.
 
+use rayon::prelude::*;
+
 use crate::math::{Point3, Real, Vector3};
 
 use super::angle_curvature::transverse_rows;
@@ -65,23 +67,32 @@ impl<'a> SurfacePointProblem<'a> {
         x
     }
 
-    /// Appends residual `r` with vertex gradients `(vertex, ∂r/∂x)`.
-    fn push(&self, out: &mut Residuals, r: Real, grads: &[(u32, Vector3)]) {
-        for &(v, g) in grads {
-            if let Some(base) = self.var_of[v as usize] {
-                push_vertex(out, base, &g);
+    /// Lays out the rows of [`residuals`](LeastSquares::residuals): one per
+    /// edge spring, three per joint (angle and two curvature rows), each
+    /// naming its free vertices' variables; values and gradients zero.
+    fn lay_out(&self, out: &mut Residuals) {
+        out.clear();
+        let mut row = |bases: &mut dyn Iterator<Item = usize>| {
+            for base in bases {
+                out.vars.extend_from_slice(&[base, base + 1, base + 2]);
+            }
+            out.start.push(out.vars.len());
+        };
+        for &[a, b] in &self.energy.edges {
+            row(&mut [b, a].iter().filter_map(|&v| self.var_of[v as usize]));
+        }
+        for layout in &self.joint_layouts {
+            for _ in 0..3 {
+                row(&mut layout.bases[..layout.count].iter().copied());
             }
         }
-        out.values.push(r);
-        out.start.push(out.vars.len());
+        out.grads.resize(out.vars.len(), 0.0);
+        out.values.resize(out.start.len() - 1, 0.0);
     }
 }
 
-/// Appends the gradient `g` of a vertex whose first variable is `base`.
-fn push_vertex(out: &mut Residuals, base: usize, g: &Vector3) {
-    out.vars.extend_from_slice(&[base, base + 1, base + 2]);
-    out.grads.extend_from_slice(&[g.x, g.y, g.z]);
-}
+/// Joints per parallel task of [`SurfacePointProblem::residuals`].
+const JOINT_CHUNK: usize = 1024;
 
 /// A joint `[j₀, j₁, j₂, j₃]` as its distinct free vertices: a joint names
 /// its shared vertex twice (`j₁ = j₂` or `j₀ = j₂`), and its rows name each
@@ -116,19 +127,18 @@ impl JointLayout {
         layout
     }
 
-    /// Appends residual `r` whose gradients with respect to `x[jᵢ]` are `grads[i]`.
-    fn push(&self, out: &mut Residuals, r: Real, grads: [Vector3; 4]) {
+    /// Writes the gradients `grads[i]` (with respect to `x[jᵢ]`) of one row
+    /// into `out` (3 per distinct free vertex, in the order of `bases`).
+    fn write(&self, grads: [Vector3; 4], out: &mut [Real]) {
         let mut summed = [Vector3::zeros(); 4];
         for (slot, g) in self.slot.iter().zip(&grads) {
             if let Some(s) = slot {
                 summed[*s] += g;
             }
         }
-        for (base, g) in self.bases.iter().zip(&summed).take(self.count) {
-            push_vertex(out, *base, g);
+        for (o, g) in out.chunks_exact_mut(3).zip(&summed) {
+            o.copy_from_slice(g.as_slice());
         }
-        out.values.push(r);
-        out.start.push(out.vars.len());
     }
 }
 
@@ -145,31 +155,74 @@ impl LeastSquares for SurfacePointProblem<'_> {
         self.energy.energy(&self.positions(z))
     }
 
+    /// The rows are laid out once ([`lay_out`](SurfacePointProblem::lay_out));
+    /// later calls on the same `out` rewrite values and gradients in place,
+    /// the joints in parallel chunks.
     fn residuals(&self, z: &[Real], out: &mut Residuals) {
-        out.clear();
-        let x = self.positions(z);
         let e = self.energy;
+        let (ne, nj) = (e.edges.len(), e.joints.len());
+        if out.values.len() != ne + 3 * nj {
+            self.lay_out(out);
+        }
+        let x = self.positions(z);
+        let Residuals {
+            values,
+            start,
+            grads,
+            ..
+        } = out;
+        let (edge_values, mut joint_values) = values.split_at_mut(ne);
+        let (edge_grads, mut joint_grads) = grads.split_at_mut(start[ne]);
         let sl = e.k_l.sqrt();
-        let zero = Vector3::zeros();
         for (k, &[a, b]) in e.edges.iter().enumerate() {
             let d = x[b as usize] - x[a as usize];
             let l = d.norm();
-            let u = if l > 0.0 { d * (sl / l) } else { zero };
-            let r = sl * (l - e.rest_lengths[k]);
-            self.push(out, r, &[(b, u), (a, -u)]);
-        }
-        for (k, j) in e.joints.iter().enumerate() {
-            let u = x[j[1] as usize] - x[j[0] as usize];
-            let w = x[j[3] as usize] - x[j[2] as usize];
-            let (theta, gu, gw) = angle_and_gradients(&u, &w);
-            let s = e.joint_weights[k].sqrt();
-            let rows = |gu: Vector3, gw: Vector3| [-gu * s, gu * s, -gw * s, gw * s];
-            let layout = &self.joint_layouts[k];
-            layout.push(out, s * (theta - e.rest_angles[k]), rows(gu, gw));
-            for (du, dw) in transverse_rows(&u, &w, theta, e.rest_angles[k]) {
-                layout.push(out, 0.0, rows(du, dw));
+            let u = if l > 0.0 {
+                d * (sl / l)
+            } else {
+                Vector3::zeros()
+            };
+            edge_values[k] = sl * (l - e.rest_lengths[k]);
+            let free = [(b, u), (a, -u)]
+                .into_iter()
+                .filter(|&(v, _)| self.var_of[v as usize].is_some());
+            for (o, (_, g)) in edge_grads[start[k]..start[k + 1]]
+                .chunks_exact_mut(3)
+                .zip(free)
+            {
+                o.copy_from_slice(g.as_slice());
             }
         }
+        // Joint chunks with their rows' values and gradients.
+        let mut chunks = Vec::new();
+        for first in (0..nj).step_by(JOINT_CHUNK) {
+            let end = (first + JOINT_CHUNK).min(nj);
+            let (v, rest) = std::mem::take(&mut joint_values).split_at_mut(3 * (end - first));
+            joint_values = rest;
+            let len = start[ne + 3 * end] - start[ne + 3 * first];
+            let (g, rest) = std::mem::take(&mut joint_grads).split_at_mut(len);
+            joint_grads = rest;
+            chunks.push((first..end, v, g));
+        }
+        chunks.into_par_iter().for_each(|(range, values, grads)| {
+            let mut at = 0;
+            for (k, value) in range.zip(values.chunks_exact_mut(3)) {
+                let j = &e.joints[k];
+                let u = x[j[1] as usize] - x[j[0] as usize];
+                let w = x[j[3] as usize] - x[j[2] as usize];
+                let (theta, gu, gw) = angle_and_gradients(&u, &w);
+                let s = e.joint_weights[k].sqrt();
+                let rows = |gu: Vector3, gw: Vector3| [-gu * s, gu * s, -gw * s, gw * s];
+                let [t1, t2] = transverse_rows(&u, &w, theta, e.rest_angles[k]);
+                let layout = &self.joint_layouts[k];
+                let width = 3 * layout.count;
+                value.copy_from_slice(&[s * (theta - e.rest_angles[k]), 0.0, 0.0]);
+                for (du, dw) in [(gu, gw), t1, t2] {
+                    layout.write(rows(du, dw), &mut grads[at..at + width]);
+                    at += width;
+                }
+            }
+        });
     }
 
     fn gradient_norm(&self, _z: &[Real], gradient: &[Real]) -> Real {
