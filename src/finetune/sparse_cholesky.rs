@@ -33,6 +33,7 @@
 //! factors the assembled values.
 
 use nalgebra::{Matrix3, Vector3};
+use rayon::prelude::*;
 
 use crate::math::Real;
 
@@ -142,43 +143,64 @@ impl CholeskyPattern {
             c_rows.push(k);
             c_start[k + 1] = c_rows.len();
         }
-        // Stored block of (row block, column block), row ≤ column, cached
-        // for the few block pairs of one group.
-        let mut cache: Vec<((usize, usize), usize)> = Vec::new();
-        let slot = |cache: &mut Vec<((usize, usize), usize)>, i: usize, j: usize| {
+        // The stored block of (row block, column block), row ≤ column.
+        let stored = |row: usize, col: usize| {
+            let s = c_start[col];
+            s + c_rows[s..c_start[col + 1]].partition_point(|&x| x < row)
+        };
+        // The slot of unknowns (i, j) in `blk`, the stored block of their
+        // blocks: (row unknown, column unknown) in it, the diagonal block
+        // keeping its upper triangle.
+        let slot = |i: usize, j: usize, blk: usize| {
             let (pi, pj) = (place[i], place[j]);
-            // In the block: (row unknown, column unknown); the diagonal
-            // block keeps its upper triangle.
             let ((row, r), (col, c)) = if pi.0 <= pj.0 { (pi, pj) } else { (pj, pi) };
             let (r, c) = if row == col {
                 (r.min(c), r.max(c))
             } else {
                 (r, c)
             };
-            let blk = match cache.iter().find(|e| e.0 == (row, col)) {
-                Some(e) => e.1,
-                None => {
-                    let s = c_start[col];
-                    let blk = s + c_rows[s..c_start[col + 1]].partition_point(|&x| x < row);
-                    cache.push(((row, col), blk));
-                    blk
-                }
-            };
             9 * blk + 3 * r + c
         };
-        let mut slots = Vec::new();
-        for group in groups {
-            for (p, &i) in group.iter().enumerate() {
-                for &j in &group[p..] {
-                    slots.push(slot(&mut cache, i, j));
+        // Groups in parallel chunks; a group's few distinct blocks are
+        // looked up pairwise once, not once per pair of unknowns.
+        let chunks: Vec<Vec<usize>> = groups
+            .par_chunks(1024)
+            .map(|chunk| {
+                let mut out = Vec::new();
+                let (mut distinct, mut index, mut table) = (Vec::new(), Vec::new(), Vec::new());
+                for group in chunk {
+                    distinct.clear();
+                    index.clear();
+                    for &i in group.iter() {
+                        let b = place[i].0;
+                        let t = distinct.iter().position(|&d| d == b).unwrap_or_else(|| {
+                            distinct.push(b);
+                            distinct.len() - 1
+                        });
+                        index.push(t);
+                    }
+                    let d = distinct.len();
+                    table.clear();
+                    table.resize(d * d, 0);
+                    for u in 0..d {
+                        for v in u..d {
+                            let (a, b) = (distinct[u], distinct[v]);
+                            let blk = stored(a.min(b), a.max(b));
+                            table[u * d + v] = blk;
+                            table[v * d + u] = blk;
+                        }
+                    }
+                    for (p, &i) in group.iter().enumerate() {
+                        for (q, &j) in group.iter().enumerate().skip(p) {
+                            out.push(slot(i, j, table[index[p] * d + index[q]]));
+                        }
+                    }
                 }
-            }
-            cache.clear();
-        }
-        for i in 0..n {
-            slots.push(slot(&mut cache, i, i));
-            cache.clear();
-        }
+                out
+            })
+            .collect();
+        let mut slots = chunks.concat();
+        slots.extend((0..n).map(|i| slot(i, i, stored(place[i].0, place[i].0))));
         let parent = elimination_tree(nb, &c_start, &c_rows);
         let mut counts = vec![1usize; nb];
         let mut mark = vec![usize::MAX; nb];
