@@ -39,7 +39,10 @@ use std::time::Instant;
 use crate::math::Real;
 
 use super::refined_step::preconditioned_solution;
-use super::sparse_cholesky::CholeskyPattern;
+use super::sparse_cholesky::{CholeskyPattern, join_if};
+
+/// Problems with at least this many runs of rows assemble `H` on two threads.
+const PARALLEL_RUNS: usize = 2048;
 
 /// Which minimiser fine tuning uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -246,11 +249,16 @@ pub fn levenberg_marquardt<P: LeastSquares>(problem: &P, z0: &[Real], params: &L
     let (pattern, slots) = CholeskyPattern::new(n, &problem.nodes(), &groups);
     timings.symbolic += lap(&mut clock);
     let diag_slots = &slots[slots.len() - n..];
-    let (mut h, mut h2) = (
-        vec![0.0; pattern.num_values()],
-        vec![0.0; pattern.num_values()],
-    );
-    let (mut g, mut g2) = (vec![0.0; n], vec![0.0; n]);
+    // H and g, and the second thread's arrays (empty when serial).
+    let parallel = runs.len() >= PARALLEL_RUNS;
+    let (mut h, mut h2) = (vec![0.0; pattern.num_values()], Vec::new());
+    let (mut g, mut g2) = (vec![0.0; n], Vec::new());
+    if parallel {
+        h2 = h.clone();
+        g2 = g.clone();
+    }
+    let (first_half, second_half) =
+        runs.split_at(if parallel { runs.len() / 2 } else { runs.len() });
     let mut run = LmRun {
         z: Vec::new(),
         energies: Vec::new(),
@@ -267,8 +275,8 @@ pub fn levenberg_marquardt<P: LeastSquares>(problem: &P, z0: &[Real], params: &L
     loop {
         // E, g = 2 Jᵀr and H = 2 JᵀJ at z: the two halves of the runs on
         // two threads, the second into its own arrays, added after.
-        let (first_half, second_half) = runs.split_at(runs.len() / 2);
-        let (e1, e2) = rayon::join(
+        let (e1, e2) = join_if(
+            parallel,
             || accumulate(&rows, first_half, &slots, &mut h, &mut g),
             || accumulate(&rows, second_half, &slots, &mut h2, &mut g2),
         );

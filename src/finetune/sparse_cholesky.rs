@@ -62,6 +62,9 @@ pub struct CholeskyPattern {
     split: (usize, usize),
 }
 
+/// Groups per parallel task of [`CholeskyPattern::new`]'s slots.
+const GROUP_CHUNK: usize = 1024;
+
 /// Factors of at least this many blocks are split between two threads at
 /// nested dissection's first separator (smaller ones are not worth the
 /// synchronisation of every separator row).
@@ -163,43 +166,46 @@ impl CholeskyPattern {
         };
         // Groups in parallel chunks; a group's few distinct blocks are
         // looked up pairwise once, not once per pair of unknowns.
-        let chunks: Vec<Vec<usize>> = groups
-            .par_chunks(1024)
-            .map(|chunk| {
-                let mut out = Vec::new();
-                let (mut distinct, mut index, mut table) = (Vec::new(), Vec::new(), Vec::new());
-                for group in chunk {
-                    distinct.clear();
-                    index.clear();
-                    for &i in group.iter() {
-                        let b = place[i].0;
-                        let t = distinct.iter().position(|&d| d == b).unwrap_or_else(|| {
-                            distinct.push(b);
-                            distinct.len() - 1
-                        });
-                        index.push(t);
-                    }
-                    let d = distinct.len();
-                    table.clear();
-                    table.resize(d * d, 0);
-                    for u in 0..d {
-                        for v in u..d {
-                            let (a, b) = (distinct[u], distinct[v]);
-                            let blk = stored(a.min(b), a.max(b));
-                            table[u * d + v] = blk;
-                            table[v * d + u] = blk;
-                        }
-                    }
-                    for (p, &i) in group.iter().enumerate() {
-                        for (q, &j) in group.iter().enumerate().skip(p) {
-                            out.push(slot(i, j, table[index[p] * d + index[q]]));
-                        }
+        let chunk_slots = |chunk: &[&[usize]]| {
+            let mut out = Vec::new();
+            let (mut distinct, mut index, mut table) = (Vec::new(), Vec::new(), Vec::new());
+            for group in chunk {
+                distinct.clear();
+                index.clear();
+                for &i in group.iter() {
+                    let b = place[i].0;
+                    let t = distinct.iter().position(|&d| d == b).unwrap_or_else(|| {
+                        distinct.push(b);
+                        distinct.len() - 1
+                    });
+                    index.push(t);
+                }
+                let d = distinct.len();
+                table.clear();
+                table.resize(d * d, 0);
+                for u in 0..d {
+                    for v in u..d {
+                        let (a, b) = (distinct[u], distinct[v]);
+                        let blk = stored(a.min(b), a.max(b));
+                        table[u * d + v] = blk;
+                        table[v * d + u] = blk;
                     }
                 }
-                out
-            })
-            .collect();
-        let mut slots = chunks.concat();
+                for (p, &i) in group.iter().enumerate() {
+                    for (q, &j) in group.iter().enumerate().skip(p) {
+                        out.push(slot(i, j, table[index[p] * d + index[q]]));
+                    }
+                }
+            }
+            out
+        };
+        // One chunk stays on this thread (a hand-over to rayon's pool costs more).
+        let mut slots = if groups.len() > GROUP_CHUNK {
+            let chunks: Vec<Vec<usize>> = groups.par_chunks(GROUP_CHUNK).map(chunk_slots).collect();
+            chunks.concat()
+        } else {
+            chunk_slots(groups)
+        };
         slots.extend((0..n).map(|i| slot(i, i, stored(place[i].0, place[i].0))));
         let parent = elimination_tree(nb, &c_start, &c_rows);
         let mut counts = vec![1usize; nb];
@@ -290,7 +296,11 @@ impl CholeskyPattern {
     /// accumulator for the separator's rows, and the rest serially.
     pub fn factor(&self, values: &[Real]) -> Option<Cholesky<'_>> {
         // On a worker thread of the pool, so that each separator row's join is cheap.
-        rayon::scope(|_| self.factor_on_worker(values))
+        if self.parallel_parts().is_some() {
+            rayon::scope(|_| self.factor_on_worker(values))
+        } else {
+            self.factor_on_worker(values)
+        }
     }
 
     fn factor_on_worker(&self, values: &[Real]) -> Option<Cholesky<'_>> {
@@ -326,6 +336,9 @@ impl CholeskyPattern {
         );
         // Rows of A and of B: each touches only its own columns.
         let own_rows = |cols: &mut Columns<'_>, range: std::ops::Range<usize>| {
+            if range.is_empty() {
+                return Some(());
+            }
             let mut x = vec![Matrix3::zeros(); nb];
             let mut mark = vec![usize::MAX; nb];
             let mut stack = Vec::new();
@@ -339,14 +352,15 @@ impl CholeskyPattern {
             }
             Some(())
         };
-        let (done_a, done_b) = rayon::join(
+        let (done_a, done_b) = join_if(
+            b_end > a_end,
             || own_rows(&mut a, 0..a_end),
             || own_rows(&mut b, a_end..b_end),
         );
         done_a?;
         done_b?;
         // Separator rows.
-        let mut x = [(); 3].map(|_| vec![Matrix3::zeros(); nb]);
+        let mut x = [(); 3].map(|_| vec![Matrix3::zeros(); if b_end < nb { nb } else { 0 }]);
         let mut mark = vec![usize::MAX; nb];
         let mut stack = Vec::new();
         let mut parts: [Vec<usize>; 3] = Default::default();
@@ -496,7 +510,11 @@ impl Cholesky<'_> {
     /// columns of parts A and B on two threads (forward before the
     /// separator, backward after it).
     pub fn solution(&self, b: &[Real]) -> Vec<Real> {
-        rayon::scope(|_| self.solution_on_worker(b))
+        if self.pattern.parallel_parts().is_some() {
+            rayon::scope(|_| self.solution_on_worker(b))
+        } else {
+            self.solution_on_worker(b)
+        }
     }
 
     fn solution_on_worker(&self, b: &[Real]) -> Vec<Real> {
@@ -510,7 +528,9 @@ impl Cholesky<'_> {
         let (xa, rest) = x.split_at_mut(a_end);
         let (xb, xs) = rest.split_at_mut(b_end - a_end);
         // Forward: A and B each push their separator rows into an accumulator.
-        let (sa, sb) = rayon::join(
+        let parallel = b_end > a_end;
+        let (sa, sb) = join_if(
+            parallel,
             || self.forward(0, xa, b_end, nb),
             || self.forward(a_end, xb, b_end, nb),
         );
@@ -519,7 +539,11 @@ impl Cholesky<'_> {
         }
         self.forward(b_end, xs, nb, nb);
         self.backward(b_end, xs, &[]);
-        rayon::join(|| self.backward(0, xa, xs), || self.backward(a_end, xb, xs));
+        join_if(
+            parallel,
+            || self.backward(0, xa, xs),
+            || self.backward(a_end, xb, xs),
+        );
         (0..p.n).map(|i| x[p.place[i].0][p.place[i].1]).collect()
     }
 
@@ -573,6 +597,20 @@ impl Cholesky<'_> {
         }
     }
 }
+/// `(a(), b())`, on two threads (`rayon::join`) if `parallel`, else in turn
+/// on this one (a join from outside rayon's pool costs a hand-over to it).
+pub(super) fn join_if<A: Send, B: Send>(
+    parallel: bool,
+    a: impl FnOnce() -> A + Send,
+    b: impl FnOnce() -> B + Send,
+) -> (A, B) {
+    if parallel {
+        rayon::join(a, b)
+    } else {
+        (a(), b())
+    }
+}
+
 /// Elimination tree of a matrix given by its upper triangle by columns
 /// (Davis 2006, §4.1, with path compression).
 fn elimination_tree(n: usize, start: &[usize], rows: &[usize]) -> Vec<Option<usize>> {

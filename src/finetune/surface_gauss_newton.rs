@@ -204,7 +204,7 @@ impl LeastSquares for SurfacePointProblem<'_> {
             joint_grads = rest;
             chunks.push((first..end, v, g));
         }
-        chunks.into_par_iter().for_each(|(range, values, grads)| {
+        let fill = |(range, values, grads): (std::ops::Range<usize>, &mut [Real], &mut [Real])| {
             let mut at = 0;
             for (k, value) in range.zip(values.chunks_exact_mut(3)) {
                 let j = &e.joints[k];
@@ -222,7 +222,13 @@ impl LeastSquares for SurfacePointProblem<'_> {
                     at += width;
                 }
             }
-        });
+        };
+        // One chunk stays on this thread (a hand-over to rayon's pool costs more).
+        if chunks.len() > 1 {
+            chunks.into_par_iter().for_each(fill);
+        } else {
+            chunks.into_iter().for_each(fill);
+        }
     }
 
     fn gradient_norm(&self, _z: &[Real], gradient: &[Real]) -> Real {
