@@ -68,7 +68,7 @@ const GROUP_CHUNK: usize = 1024;
 /// Factors of at least this many blocks are split between two threads at
 /// nested dissection's first separator (smaller ones are not worth the
 /// synchronisation of every separator row).
-pub const PARALLEL_BLOCKS: usize = 512;
+const PARALLEL_BLOCKS: usize = 512;
 
 /// A numeric factor `L` (block columns, diagonal block first) with its pattern.
 #[derive(Clone, Debug)]

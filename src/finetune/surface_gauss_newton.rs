@@ -161,7 +161,7 @@ impl LeastSquares for SurfacePointProblem<'_> {
     fn residuals(&self, z: &[Real], out: &mut Residuals) {
         let e = self.energy;
         let (ne, nj) = (e.edges.len(), e.joints.len());
-        if out.values.len() != ne + 3 * nj {
+        if out.start.len() != ne + 3 * nj + 1 {
             self.lay_out(out);
         }
         let x = self.positions(z);
