@@ -149,8 +149,9 @@ pub struct LmParams {
 /// The suggested [`LmParams::refinement_iterations`]: 15. One iteration
 /// costs a product with `H` and a triangular solve pair, about a twentieth
 /// to a thirtieth of a numeric factorisation on the benchmark surface,
-/// whose steps after the first converge in 10–11 iterations (with 10 the
-/// second step missed by one and was factored afresh).
+/// whose steps after the first needed 10–11 iterations when solved to
+/// `1e-10` (with a limit of 10 the second step missed by one and was
+/// factored afresh) and need 3–6 with the forcing term [`FORCING_MAX`].
 pub const REFINEMENT_ITERATIONS: usize = 15;
 
 /// The largest forcing term of a step solved by conjugate gradients: the
