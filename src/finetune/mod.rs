@@ -53,8 +53,8 @@ pub use curve_io::{curve_json, read_alpha, read_curve, write_json};
 pub use curve_picture::{CurveLayer, comparison_layers, curve_layer, curve_picture};
 pub use edge_loops::{EdgeLoop, edge_loops};
 pub use levenberg_marquardt::{
-    FinetuneMethod, LeastSquares, LmParams, LmRun, LmTimings, REFINEMENT_ITERATIONS, Residuals,
-    levenberg_marquardt,
+    FORCING_MAX, FinetuneMethod, LeastSquares, LmParams, LmRun, LmTimings, REFINEMENT_ITERATIONS,
+    Residuals, levenberg_marquardt,
 };
 pub use refined_step::{RELATIVE_RESIDUAL, preconditioned_solution};
 pub use sparse_cholesky::{Cholesky, CholeskyPattern};

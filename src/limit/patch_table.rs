@@ -146,7 +146,7 @@ pub struct PatchTable {
 }
 
 /// Quadtree leaves by the one-ring's local structure
-/// ([`LocalPatch::shape_key`]): irregular faces with the same structure
+/// (`LocalPatch::shape_key`): irregular faces with the same structure
 /// (most faces at extraordinary vertices of one valence) share their
 /// weights, which depend on nothing else. Every [`PatchTable`] keeps one;
 /// tables built one after the other over related meshes (the levels of a
