@@ -407,19 +407,18 @@ impl CholeskyPattern {
     ) -> [Columns<'s>; 3] {
         let [a, b] = cuts;
         let (la, lb) = (self.l_start[a], self.l_start[b]);
-        let (rows_a, rows) = rows.split_at_mut(la);
-        let (rows_b, rows_s) = rows.split_at_mut(lb - la);
-        let (blocks_a, blocks) = blocks.split_at_mut(la);
-        let (blocks_b, blocks_s) = blocks.split_at_mut(lb - la);
-        let (inverse_a, inverse) = inverse.split_at_mut(a);
-        let (inverse_b, inverse_s) = inverse.split_at_mut(b - a);
-        let (next_a, next) = next.split_at_mut(a);
-        let (next_b, next_s) = next.split_at_mut(b - a);
-        [
-            Columns::new(0, 0, rows_a, blocks_a, inverse_a, next_a),
-            Columns::new(a, la, rows_b, blocks_b, inverse_b, next_b),
-            Columns::new(b, lb, rows_s, blocks_s, inverse_s, next_s),
-        ]
+        let mut rows = cut(rows, la, lb).into_iter();
+        let mut blocks = cut(blocks, la, lb).into_iter();
+        let mut inverse = cut(inverse, a, b).into_iter();
+        let mut next = cut(next, a, b).into_iter();
+        [(0, 0), (a, la), (b, lb)].map(|(first, offset)| Columns {
+            first,
+            offset,
+            rows: rows.next().expect("three parts"),
+            blocks: blocks.next().expect("three parts"),
+            inverse: inverse.next().expect("three parts"),
+            next: next.next().expect("three parts"),
+        })
     }
 
     /// [`row_pattern`] of row `k` of this pattern's factor.
@@ -441,25 +440,7 @@ struct Columns<'s> {
     next: &'s mut [usize],
 }
 
-impl<'s> Columns<'s> {
-    fn new(
-        first: usize,
-        offset: usize,
-        rows: &'s mut [usize],
-        blocks: &'s mut [Matrix3<Real>],
-        inverse: &'s mut [Matrix3<Real>],
-        next: &'s mut [usize],
-    ) -> Self {
-        Columns {
-            first,
-            offset,
-            rows,
-            blocks,
-            inverse,
-            next,
-        }
-    }
-
+impl Columns<'_> {
     /// Row `k`'s step of the up-looking factorisation in the columns
     /// `stack` (all in this range, descendants first): `Z_i = L_ii⁻¹ X_i`,
     /// `X_r −= L_ri Z_i` for the rows already in column `i`, `L_ki = Z_iᵀ`.
@@ -597,6 +578,13 @@ impl Cholesky<'_> {
         }
     }
 }
+/// `s` cut at `a ≤ b` into `[..a, a..b, b..]`.
+fn cut<T>(s: &mut [T], a: usize, b: usize) -> [&mut [T]; 3] {
+    let (first, rest) = s.split_at_mut(a);
+    let (second, third) = rest.split_at_mut(b - a);
+    [first, second, third]
+}
+
 /// `(a(), b())`, on two threads (`rayon::join`) if `parallel`, else in turn
 /// on this one (a join from outside rayon's pool costs a hand-over to it).
 pub(super) fn join_if<A: Send, B: Send>(
