@@ -161,7 +161,7 @@ pub const REFINEMENT_ITERATIONS: usize = 15;
 /// keeps Gauss-Newton's fast final convergence (Dembo, Eisenstat and
 /// Steihaug, *Inexact Newton methods*, SIAM J. Numer. Anal. 19, 1982:
 /// `η = O(|∇E|)` converges quadratically near the solution). On the
-/// benchmark surface: 16 conjugate-gradient iterations instead of 32 for the
+/// benchmark surface: 14 conjugate-gradient iterations instead of 32 for the
 /// three later steps, the same 4 Levenberg-Marquardt iterations and the
 /// same final energy.
 pub const FORCING_MAX: Real = 1e-2;
