@@ -195,6 +195,60 @@ fn levenberg_marquardt_lowers_the_energy_to_the_minimum() {
     }
 }
 
+/// `r = (2 z_0 − 2, z_1 − z_0², z_0 + z_1 − 3)`, with `z_0` named twice in
+/// the first and last rows when `split` (half of its derivative each).
+struct Repeated {
+    split: bool,
+}
+
+impl LeastSquares for Repeated {
+    fn num_vars(&self) -> usize {
+        2
+    }
+    fn nodes(&self) -> Vec<usize> {
+        vec![0, 1]
+    }
+    fn energy(&self, z: &[f64]) -> f64 {
+        let r = [2.0 * z[0] - 2.0, z[1] - z[0] * z[0], z[0] + z[1] - 3.0];
+        r.iter().map(|r| r * r).sum()
+    }
+    fn residuals(&self, z: &[f64], out: &mut Residuals) {
+        out.clear();
+        if self.split {
+            out.push(2.0 * z[0] - 2.0, [(0, 1.0), (0, 1.0)]);
+        } else {
+            out.push(2.0 * z[0] - 2.0, [(0, 2.0)]);
+        }
+        out.push(z[1] - z[0] * z[0], [(1, 1.0), (0, -2.0 * z[0])]);
+        if self.split {
+            out.push(z[0] + z[1] - 3.0, [(0, 0.5), (1, 1.0), (0, 0.5)]);
+        } else {
+            out.push(z[0] + z[1] - 3.0, [(0, 1.0), (1, 1.0)]);
+        }
+    }
+}
+
+#[test]
+fn levenberg_marquardt_adds_up_a_variable_named_twice_in_a_row() {
+    let params = LmParams {
+        gradient_tolerance: 1e-12,
+        max_iterations: 100,
+        stall_window: 0,
+        stall_relative: 0.0,
+        refinement_iterations: 0,
+    };
+    let whole = levenberg_marquardt(&Repeated { split: false }, &[3.0, -1.0], &params);
+    let split = levenberg_marquardt(&Repeated { split: true }, &[3.0, -1.0], &params);
+    assert!(whole.iterations > 1, "{} iterations", whole.iterations);
+    assert_eq!(whole.iterations, split.iterations);
+    for (a, b) in whole.energies.iter().zip(&split.energies) {
+        assert!((a - b).abs() <= 1e-12 * (1.0 + a.abs()), "{a} against {b}");
+    }
+    for (a, b) in whole.z.iter().zip(&split.z) {
+        assert!((a - b).abs() < 1e-10, "{:?} against {:?}", whole.z, split.z);
+    }
+}
+
 #[test]
 fn levenberg_marquardt_and_nonlinear_cg_reach_the_same_closed_curve() {
     let n = 12;

@@ -232,16 +232,21 @@ pub fn levenberg_marquardt<P: LeastSquares>(problem: &P, z0: &[Real], params: &L
     timings.residuals += lap(&mut clock);
     // Rows with the same variables as the row before share its slots (the
     // curvature rows follow their angle row): runs `(first row, end, first
-    // slot)`, whose `JᵀJ` is summed densely before it is scattered.
+    // slot, whether a variable repeats)`, whose `JᵀJ` is summed densely
+    // before it is scattered.
     let mut groups: Vec<&[usize]> = Vec::new();
-    let mut runs: Vec<(usize, usize, usize)> = Vec::new();
+    let mut runs: Vec<(usize, usize, usize, bool)> = Vec::new();
     let mut total = 0;
     for k in 0..rows.values.len() {
         let vars = &rows.vars[rows.start[k]..rows.start[k + 1]];
         match runs.last_mut() {
             Some(run) if groups.last() == Some(&vars) => run.1 = k + 1,
             _ => {
-                runs.push((k, k + 1, total));
+                let repeats = vars
+                    .iter()
+                    .enumerate()
+                    .any(|(p, a)| vars[p + 1..].contains(a));
+                runs.push((k, k + 1, total, repeats));
                 total += vars.len() * (vars.len() + 1) / 2;
                 groups.push(vars);
             }
@@ -392,12 +397,12 @@ pub fn levenberg_marquardt<P: LeastSquares>(problem: &P, z0: &[Real], params: &L
 }
 
 /// Sets `h` to `Σ 2 JₖᵀJₖ` (in the factor's `slots`) and `g` to `Σ 2 rₖ Jₖ`
-/// over the rows of `runs` (each `(first row, end, first slot)`: rows with
+/// over the rows of `runs` (each `(first row, end, first slot, repeats)`: rows with
 /// the same variables, whose `JᵀJ` is summed densely before it is
 /// scattered); returns `Σ rₖ²`.
 fn accumulate(
     rows: &Residuals,
-    runs: &[(usize, usize, usize)],
+    runs: &[(usize, usize, usize, bool)],
     slots: &[usize],
     h: &mut [Real],
     g: &mut [Real],
@@ -406,7 +411,7 @@ fn accumulate(
     g.iter_mut().for_each(|v| *v = 0.0);
     let mut local: Vec<Real> = Vec::new();
     let mut e = 0.0;
-    for &(first, end, first_slot) in runs {
+    for &(first, end, first_slot, repeats) in runs {
         let vars = &rows.vars[rows.start[first]..rows.start[first + 1]];
         let m = vars.len();
         local.clear();
@@ -424,22 +429,30 @@ fn accumulate(
             let mut t = 0;
             for (p, (&a, &ga)) in vars.iter().zip(grads).enumerate() {
                 g[a] += 2.0 * r * ga;
-                for &gb in &grads[p..] {
-                    local[t] += ga * gb;
-                    t += 1;
+                let tail = &grads[p..];
+                for (l, &gb) in local[t..t + tail.len()].iter_mut().zip(tail) {
+                    *l += ga * gb;
                 }
+                t += tail.len();
             }
         }
         if !used {
             continue;
         }
-        let mut t = 0;
-        for (p, &a) in vars.iter().enumerate() {
-            for (q, &b) in vars.iter().enumerate().skip(p) {
-                // A variable repeated in a row: its cross term stands for both orders.
-                let twice = if q != p && a == b { 2.0 } else { 1.0 };
-                h[slots[first_slot + t]] += 2.0 * local[t] * twice;
-                t += 1;
+        let run_slots = &slots[first_slot..first_slot + local.len()];
+        if repeats {
+            let mut t = 0;
+            for (p, &a) in vars.iter().enumerate() {
+                for (q, &b) in vars.iter().enumerate().skip(p) {
+                    // A variable repeated in a row: its cross term stands for both orders.
+                    let twice = if q != p && a == b { 2.0 } else { 1.0 };
+                    h[run_slots[t]] += 2.0 * local[t] * twice;
+                    t += 1;
+                }
+            }
+        } else {
+            for (&s, &l) in run_slots.iter().zip(&local) {
+                h[s] += 2.0 * l;
             }
         }
     }
