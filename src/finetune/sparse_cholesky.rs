@@ -296,11 +296,9 @@ impl CholeskyPattern {
     /// accumulator for the separator's rows, and the rest serially.
     pub fn factor(&self, values: &[Real]) -> Option<Cholesky<'_>> {
         // On a worker thread of the pool, so that each separator row's join is cheap.
-        if self.parallel_parts().is_some() {
-            rayon::scope(|_| self.factor_on_worker(values))
-        } else {
+        in_pool_if(self.parallel_parts().is_some(), || {
             self.factor_on_worker(values)
-        }
+        })
     }
 
     fn factor_on_worker(&self, values: &[Real]) -> Option<Cholesky<'_>> {
@@ -491,11 +489,9 @@ impl Cholesky<'_> {
     /// columns of parts A and B on two threads (forward before the
     /// separator, backward after it).
     pub fn solution(&self, b: &[Real]) -> Vec<Real> {
-        if self.pattern.parallel_parts().is_some() {
-            rayon::scope(|_| self.solution_on_worker(b))
-        } else {
+        in_pool_if(self.pattern.parallel_parts().is_some(), || {
             self.solution_on_worker(b)
-        }
+        })
     }
 
     fn solution_on_worker(&self, b: &[Real]) -> Vec<Real> {
@@ -512,13 +508,13 @@ impl Cholesky<'_> {
         let parallel = b_end > a_end;
         let (sa, sb) = join_if(
             parallel,
-            || self.forward(0, xa, b_end, nb),
-            || self.forward(a_end, xb, b_end, nb),
+            || self.forward(0, xa, b_end),
+            || self.forward(a_end, xb, b_end),
         );
         for ((v, ua), ub) in xs.iter_mut().zip(&sa).zip(&sb) {
             *v += ua + ub;
         }
-        self.forward(b_end, xs, nb, nb);
+        self.forward(b_end, xs, nb);
         self.backward(b_end, xs, &[]);
         join_if(
             parallel,
@@ -530,16 +526,10 @@ impl Cholesky<'_> {
 
     /// Forward substitution over the columns `first …` held in `x`; updates
     /// of rows from `sep` on go to the returned accumulator (indexed from
-    /// `sep`, of length `nb − sep`).
-    fn forward(
-        &self,
-        first: usize,
-        x: &mut [Vector3<Real>],
-        sep: usize,
-        nb: usize,
-    ) -> Vec<Vector3<Real>> {
+    /// `sep`).
+    fn forward(&self, first: usize, x: &mut [Vector3<Real>], sep: usize) -> Vec<Vector3<Real>> {
         let l_start = &self.pattern.l_start;
-        let mut out = vec![Vector3::zeros(); nb - sep];
+        let mut out = vec![Vector3::zeros(); l_start.len() - 1 - sep];
         for c in 0..x.len() {
             let j = first + c;
             let y = self.inverse[j] * x[c];
@@ -583,6 +573,12 @@ fn cut<T>(s: &mut [T], a: usize, b: usize) -> [&mut [T]; 3] {
     let (first, rest) = s.split_at_mut(a);
     let (second, third) = rest.split_at_mut(b - a);
     [first, second, third]
+}
+
+/// `f()` on a worker thread of rayon's pool if `parallel` (so that the joins
+/// inside it are cheap), else on this one.
+fn in_pool_if<R: Send>(parallel: bool, f: impl FnOnce() -> R + Send) -> R {
+    if parallel { rayon::scope(|_| f()) } else { f() }
 }
 
 /// `(a(), b())`, on two threads (`rayon::join`) if `parallel`, else in turn
