@@ -57,14 +57,14 @@ pub fn patch_stiffness_and_damping(
 }
 
 /// The elements of [`patch_stiffness_and_damping`] before they are carried
-/// to the control points: for every patch, its level-`L` columns (sorted)
-/// and the row-major `K_e` and `D_e` over them.
+/// to the control points: for every patch, its level-`L` columns and the
+/// row-major `K_e` and `D_e` over them ([`PatchElements::get`]).
 pub fn stiffness_and_damping_elements(
     table: &PatchTable,
     order: usize,
     params: &MaterialParams,
     gamma: Real,
-) -> Result<Vec<PatchElement<2>>> {
+) -> Result<PatchElements<2>> {
     params.check()?;
     damping_params(gamma).check()?;
     elements(
@@ -74,9 +74,41 @@ pub fn stiffness_and_damping_elements(
     )
 }
 
-/// A patch's level-`L` columns (sorted) and one row-major matrix over them
-/// per weight set.
-pub type PatchElement<const N: usize> = (Vec<u32>, [Vec<Real>; N]);
+/// Every patch's element: its level-`L` columns (distinct, in no
+/// particular order) and one row-major matrix over them per weight set.
+/// Patches with equal matrices share one copy: the interior regular patches
+/// of one frame (their columns are their 16 grid vertices in grid order),
+/// and the irregular patches of one local structure and frame (their
+/// columns in quadtree order).
+#[derive(Clone, Debug)]
+pub struct PatchElements<const N: usize> {
+    col_offsets: Vec<usize>,
+    cols: Vec<u32>,
+    /// Each patch's entry in `matrices`.
+    which: Vec<u32>,
+    matrices: Vec<Matrices<N>>,
+}
+
+impl<const N: usize> PatchElements<N> {
+    /// Patch `f`'s columns and matrices.
+    pub fn get(&self, f: usize) -> (&[u32], [&[Real]; N]) {
+        let m = &self.matrices[self.which[f] as usize];
+        (
+            &self.cols[self.col_offsets[f]..self.col_offsets[f + 1]],
+            std::array::from_fn(|i| &m[i][..]),
+        )
+    }
+
+    /// Number of patches.
+    pub fn len(&self) -> usize {
+        self.which.len()
+    }
+
+    /// True when there are no patches.
+    pub fn is_empty(&self) -> bool {
+        self.which.is_empty()
+    }
+}
 
 /// The weights of `[J, J_u, J_v, J_uu, J_uv, J_vv]` in `K` (eq. 12).
 fn stiffness_weights(params: &MaterialParams) -> [Real; 6] {
@@ -131,19 +163,21 @@ fn assembled<const N: usize>(
 /// Every patch's element for each set of weights `c`. Irregular patches
 /// with the same local structure and frame share one computation: their
 /// keys are found first, one patch of each distinct key is integrated, and
-/// every patch then takes its key's matrices reordered to its columns.
+/// every such patch then refers to its key's matrices over its own columns.
+/// Regular patches share their frame's grid matrix where their grid rows
+/// select 16 distinct vertices (the interior); the others carry it.
 fn elements<const N: usize>(
     table: &PatchTable,
     order: usize,
     c: [[Real; 6]; N],
-) -> Result<Vec<PatchElement<N>>> {
+) -> Result<PatchElements<N>> {
     if order == 0 || order > 16 {
         return Err(Error::Input(format!(
             "quadrature order {order} must be between 1 and 16"
         )));
     }
     let gl = gauss_legendre(order);
-    let shapes: Vec<Option<(Vec<u32>, ShapeKey)>> = (0..table.num_patches())
+    let shapes: Vec<Option<(&[u32], ShapeKey)>> = (0..table.num_patches())
         .into_par_iter()
         .map(|f| {
             table
@@ -161,44 +195,97 @@ fn elements<const N: usize>(
     // A structure's matrices over its quadtree columns, or `None` when its
     // stencils leave those columns (then every such patch is integrated on
     // its own).
-    let shared: HashMap<&ShapeKey, Option<Matrices<N>>> = first
+    let shared: Vec<Option<Matrices<N>>> = first
         .par_iter()
-        .map(|&(key, f)| {
-            let local = shapes[f].as_ref().map(|(local, _)| &local[..]);
+        .map(|&(_, f)| {
+            let local = shapes[f].map(|(local, _)| local);
             let (_, matrices, on_local) = irregular_element(table, f, &gl, c, local);
-            (key, on_local.then_some(matrices))
+            on_local.then_some(matrices)
         })
         .collect();
-    Ok((0..table.num_patches())
+    let mut matrices: Vec<Matrices<N>> = Vec::new();
+    let mut entry: HashMap<&ShapeKey, u32> = HashMap::new();
+    for ((key, _), m) in first.iter().zip(shared) {
+        if let Some(m) = m {
+            entry.insert(key, matrices.len() as u32);
+            matrices.push(m);
+        }
+    }
+    // The regular frames' grid matrices, numbered in the order met.
+    let mut frames: Vec<[[Real; 2]; 2]> = Vec::new();
+    let frame_of: Vec<Option<u32>> = (0..table.num_patches())
+        .map(|f| {
+            table.grid_rows(f).map(|_| {
+                let axes = table.patch_frame(f).1;
+                let k = frames.iter().position(|a| *a == axes).unwrap_or_else(|| {
+                    frames.push(axes);
+                    frames.len() - 1
+                });
+                (matrices.len() + k) as u32
+            })
+        })
+        .collect();
+    matrices.extend(frames.iter().map(|&axes| grid_matrices(axes, &gl, c)));
+    // Each patch: its columns, and either a shared entry or its own matrices.
+    let own: Vec<(Vec<u32>, Entry<N>)> = (0..table.num_patches())
         .into_par_iter()
-        .map_init(Vec::new, |frames, f| {
-            let own = || {
+        .map(|f| match (table.grid_rows(f), &shapes[f]) {
+            (Some(grid), _) => {
+                let shared = frame_of[f].expect("regular patches have a frame");
+                match selected(&grid) {
+                    Some(cols) => (cols, Entry::Shared(shared)),
+                    None => {
+                        let (cols, g) = grid_matrix(&grid);
+                        let e = &matrices[shared as usize];
+                        let m = cols.len();
+                        (
+                            cols,
+                            Entry::Own(std::array::from_fn(|i| carried(&e[i], &g, m))),
+                        )
+                    }
+                }
+            }
+            (None, Some((local, key))) if entry.contains_key(key) => {
+                (local.to_vec(), Entry::Shared(entry[key]))
+            }
+            _ => {
                 let (cols, matrices, _) = irregular_element(table, f, &gl, c, None);
-                (cols, matrices)
-            };
-            match (table.grid_rows(f), &shapes[f]) {
-                (Some(grid), _) => regular_element(table, f, grid, &gl, c, frames),
-                (None, Some((local, key))) => match &shared[key] {
-                    Some(matrices) => sorted_element(local, matrices),
-                    None => own(),
-                },
-                (None, None) => own(),
+                (cols, Entry::Own(matrices))
             }
         })
-        .collect())
+        .collect();
+    let mut out = PatchElements {
+        col_offsets: vec![0],
+        cols: Vec::new(),
+        which: Vec::with_capacity(own.len()),
+        matrices,
+    };
+    for (cols, m) in own {
+        out.cols.extend(cols);
+        out.col_offsets.push(out.cols.len());
+        out.which.push(match m {
+            Entry::Shared(k) => k,
+            Entry::Own(m) => {
+                out.matrices.push(m);
+                (out.matrices.len() - 1) as u32
+            }
+        });
+    }
+    Ok(out)
 }
 
 /// `Sᵀ (Σ_e K_e) S` of each weight set's elements.
 fn scattered<const N: usize>(
     table: &PatchTable,
-    per_patch: &[PatchElement<N>],
+    per_patch: &PatchElements<N>,
 ) -> Result<[StencilTable; N]> {
     let s = table.to_level();
     let mut out = Vec::with_capacity(N);
     for i in 0..N {
         let mut elements = Elements::new();
-        for (cols, matrices) in per_patch {
-            elements.push(cols, &matrices[i])?;
+        for f in 0..per_patch.len() {
+            let (cols, matrices) = per_patch.get(f);
+            elements.push(cols, matrices[i])?;
         }
         out.push(StencilTable::from_elements(s.num_rows(), &elements)?.pulled_back(s)?);
     }
@@ -207,14 +294,18 @@ fn scattered<const N: usize>(
         .unwrap_or_else(|_| unreachable!("one matrix per weight set")))
 }
 
-/// The regular patches' `16 × 16` grid matrices by frame (per thread).
-type FrameCache<const N: usize> = Vec<([[Real; 2]; 2], Matrices<N>)>;
+/// A patch's matrices: a shared entry of [`PatchElements`] or its own.
+enum Entry<const N: usize> {
+    Shared(u32),
+    Own(Matrices<N>),
+}
 
 /// One row-major matrix per weight set.
 type Matrices<const N: usize> = [Vec<Real>; N];
 
-/// An irregular patch's local structure and the bits of its frame.
-type ShapeKey = (Vec<u64>, [u64; 4]);
+/// An irregular patch's local structure (its number in the table's
+/// quadtree cache) and the bits of its frame.
+type ShapeKey = (usize, [u64; 4]);
 
 /// Patch `f`'s inverse frame (base `(u, v)` to its `(s, t)`) and the
 /// frame's |determinant|.
@@ -268,36 +359,41 @@ fn add_outer_one<'a>(
     }
 }
 
-/// The element of regular patch `f` (its 16 grid rows `grid`) over the
-/// level-`L` vertices (columns and row-major matrices). `frames` keeps the
-/// grid matrices of the frames seen so far.
-fn regular_element<const N: usize>(
-    table: &PatchTable,
-    f: usize,
-    grid: [(&[u32], &[Real]); 16],
+/// The `16 × 16` matrices over the 16 grid points of a regular patch with
+/// frame `axes` (exact with a 4 × 4 or finer Gauss-Legendre rule).
+fn grid_matrices<const N: usize>(
+    axes: [[Real; 2]; 2],
     gl: &[(Real, Real)],
     c: [[Real; 6]; N],
-    frames: &mut FrameCache<N>,
-) -> PatchElement<N> {
-    let (_, axes) = table.patch_frame(f);
+) -> Matrices<N> {
     let (inv, det) = inverse(axes);
-    // Regular: the frame's 16 × 16 grid matrix, carried by the grid rows G
-    // (a selection for interior patches) as Gᵀ E G.
-    let e = match frames.iter().position(|(a, _)| *a == axes) {
-        Some(i) => &frames[i].1,
-        None => {
-            let mut e = [(); N].map(|_| vec![0.0; 256]);
-            for &(a, wa) in gl {
-                for &(b, wb) in gl {
-                    let mut rows = patch_weights(a, b);
-                    rows_to_base(&mut rows, inv);
-                    add_outer(&mut e, 16, c, wa * wb * det, |q| &rows[q]);
-                }
-            }
-            frames.push((axes, e));
-            &frames.last().expect("just pushed").1
+    let mut e = [(); N].map(|_| vec![0.0; 256]);
+    for &(a, wa) in gl {
+        for &(b, wb) in gl {
+            let mut rows = patch_weights(a, b);
+            rows_to_base(&mut rows, inv);
+            add_outer(&mut e, 16, c, wa * wb * det, |q| &rows[q]);
         }
-    };
+    }
+    e
+}
+
+/// The 16 grid vertices in grid order when every grid row is one distinct
+/// vertex with weight 1 (an interior regular patch): its element is then
+/// the grid matrix itself over them.
+fn selected(grid: &[(&[u32], &[Real]); 16]) -> Option<Vec<u32>> {
+    let cols: Vec<u32> = grid
+        .iter()
+        .map(|(c, w)| (c.len() == 1 && w[0] == 1.0).then(|| c[0]))
+        .collect::<Option<_>>()?;
+    let mut sorted = cols.clone();
+    sorted.sort_unstable();
+    sorted.windows(2).all(|w| w[0] != w[1]).then_some(cols)
+}
+
+/// The sorted columns of grid rows `grid` and the rows as a dense `16 × m`
+/// matrix `G` over them (a patch's element is then `Gᵀ E G`).
+fn grid_matrix(grid: &[(&[u32], &[Real]); 16]) -> (Vec<u32>, Vec<Real>) {
     let mut cols: Vec<u32> = grid.iter().flat_map(|(c, _)| c.iter().copied()).collect();
     cols.sort_unstable();
     cols.dedup();
@@ -308,7 +404,7 @@ fn regular_element<const N: usize>(
             g[k * m + cols.binary_search(&col).unwrap_or(0)] += x;
         }
     }
-    (cols, std::array::from_fn(|i| carried(&e[i], &g, m)))
+    (cols, g)
 }
 
 /// The element of irregular patch `f`: the exact stencils at the Gauss
@@ -373,24 +469,6 @@ fn irregular_element<const N: usize>(
         add_outer(&mut matrix, m, c, *w, |q| &dense[q]);
     }
     (cols, matrix, local.is_some())
-}
-
-/// Columns `cols` sorted, with each row-major `m × m` matrix over them
-/// reordered to match.
-fn sorted_element<const N: usize>(cols: &[u32], matrices: &[Vec<Real>; N]) -> PatchElement<N> {
-    let m = cols.len();
-    let mut order: Vec<usize> = (0..m).collect();
-    order.sort_unstable_by_key(|&i| cols[i]);
-    let sorted = order.iter().map(|&i| cols[i]).collect();
-    let reordered = std::array::from_fn(|k| {
-        let a = &matrices[k];
-        let mut out = Vec::with_capacity(m * m);
-        for &i in &order {
-            out.extend(order.iter().map(|&j| a[i * m + j]));
-        }
-        out
-    });
-    (sorted, reordered)
 }
 
 /// `Gᵀ E G` for the `16 × 16` grid matrix `E` and the `16 × m` grid rows `G`.

@@ -10,7 +10,7 @@ mod quadrature;
 mod sample_rows;
 
 pub use elements::{
-    PatchElement, parameter_area, patch_damping_matrix, patch_stiffness_and_damping,
+    PatchElements, parameter_area, patch_damping_matrix, patch_stiffness_and_damping,
     patch_stiffness_matrix, stiffness_and_damping_elements,
 };
 pub use matrices::{MaterialParams, damping_matrix, mass_matrix, stiffness_matrix};

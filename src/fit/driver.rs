@@ -167,10 +167,7 @@ pub fn fit_point_cloud(
             params.damping / area,
         )?;
         let [k, d] = assembly
-            .values_of_elements(table, |f| {
-                let (cols, [k, d]) = &elements[f];
-                (&cols[..], [&k[..], &d[..]])
-            })?
+            .values_of_elements(table, |f| elements.get(f))?
             .map(|values| assembly.matrix(values));
         let mut kd_values: Vec<Real> = k
             .weights

@@ -60,47 +60,24 @@ pub(crate) struct LocalPatch {
 impl LocalPatch {
     /// The 1-ring of `face` in `level`, with identity rows over its vertices.
     pub(crate) fn around(level: &Level, sharp: &Sharpness, face: usize) -> LocalPatch {
-        let (sub, map) = one_ring(level, sharp, face);
+        Self::of_ring(level, sharp, Ring::of(level, face))
+    }
+
+    /// The patch of a gathered [`Ring`] of `level`, with identity rows.
+    pub(crate) fn of_ring(level: &Level, sharp: &Sharpness, ring: Ring) -> LocalPatch {
+        let ((level, sharp, face), map) = ring.sub_mesh(level, sharp);
         let n = map.len();
         let mut rows = vec![0.0; n * n];
         for i in 0..n {
             rows[i * n + i] = 1.0;
         }
         LocalPatch {
-            level: sub.0,
-            sharp: sub.1,
+            level,
+            sharp,
             cols: map,
             rows,
-            face: sub.2,
+            face,
         }
-    }
-
-    /// Everything the local subdivision of this patch depends on besides
-    /// `cols` (its rows are the identity): local topology, sharpness and the
-    /// face followed. Patches with equal keys refine to equal weights.
-    pub(crate) fn shape_key(&self) -> Vec<u64> {
-        let l = &self.level;
-        let mut key = Vec::with_capacity(
-            2 + l.face_offsets.len()
-                + l.face_verts.len()
-                + self.sharp.edge.len()
-                + self.sharp.vertex.len(),
-        );
-        key.extend([self.face as u64, l.num_vertices as u64]);
-        key.extend(
-            l.face_offsets
-                .iter()
-                .chain(&l.face_verts)
-                .map(|&x| x as u64),
-        );
-        key.extend(
-            self.sharp
-                .edge
-                .iter()
-                .chain(&self.sharp.vertex)
-                .map(|x| x.to_bits()),
-        );
-        key
     }
 
     fn ncols(&self) -> usize {
@@ -150,7 +127,7 @@ impl LocalPatch {
 
     /// The 1-ring of local face `face`, as a patch of its own.
     pub(crate) fn extract(&self, face: u32) -> LocalPatch {
-        let (sub, map) = one_ring(&self.level, &self.sharp, face as usize);
+        let (sub, map) = Ring::of(&self.level, face as usize).sub_mesh(&self.level, &self.sharp);
         let nc = self.ncols();
         let mut rows = Vec::with_capacity(map.len() * nc);
         for &v in &map {
@@ -197,50 +174,96 @@ impl LocalPatch {
     }
 }
 
-/// The sub-mesh of faces sharing a vertex with `face`: its level, sharpness
-/// (rim edges marked infinitely sharp so rim vertices stay well defined),
-/// the local index of `face`, and the map local vertex → vertex of `level`.
-fn one_ring(level: &Level, sharp: &Sharpness, face: usize) -> ((Level, Sharpness, u32), Vec<u32>) {
-    let mut faces: Vec<u32> = vec![face as u32];
-    for &v in level.face_vertices(face) {
-        for &g in level.vertex_faces(v as usize) {
-            if !faces.contains(&g) {
-                faces.push(g);
-            }
-        }
-    }
-    let mut map: Vec<u32> = Vec::new();
-    let mut offsets = vec![0u32];
-    let mut verts = Vec::new();
-    for &g in &faces {
-        for &v in level.face_vertices(g as usize) {
-            let l = match map.iter().position(|&x| x == v) {
-                Some(l) => l,
-                None => {
-                    map.push(v);
-                    map.len() - 1
+/// The faces sharing a vertex with a face of a level (that face first) and
+/// their corners in a local numbering: `map[l]` is local vertex `l`'s vertex
+/// of the level, face `i` has local corners `verts[offsets[i]..offsets[i + 1]]`.
+pub(crate) struct Ring {
+    faces: Vec<u32>,
+    pub(crate) map: Vec<u32>,
+    offsets: Vec<u32>,
+    verts: Vec<u32>,
+}
+
+impl Ring {
+    /// The ring of `face` in `level`.
+    pub(crate) fn of(level: &Level, face: usize) -> Ring {
+        let mut faces: Vec<u32> = vec![face as u32];
+        for &v in level.face_vertices(face) {
+            for &g in level.vertex_faces(v as usize) {
+                if !faces.contains(&g) {
+                    faces.push(g);
                 }
-            };
-            verts.push(l as u32);
-        }
-        offsets.push(verts.len() as u32);
-    }
-    let sub = Level::from_faces(map.len(), &offsets, &verts)
-        .expect("a sub-mesh of a valid level is valid");
-    let edge = sub
-        .edge_verts
-        .iter()
-        .enumerate()
-        .map(|(e, &[a, b])| {
-            if sub.is_boundary_edge(e) {
-                SHARPNESS_INFINITE
-            } else {
-                find_edge(level, map[a as usize], map[b as usize]).map_or(0.0, |g| sharp.edge[g])
             }
-        })
-        .collect();
-    let vertex = map.iter().map(|&v| sharp.vertex[v as usize]).collect();
-    ((sub, Sharpness { edge, vertex }, 0), map)
+        }
+        let mut map: Vec<u32> = Vec::new();
+        let mut offsets = vec![0u32];
+        let mut verts = Vec::new();
+        for &g in &faces {
+            for &v in level.face_vertices(g as usize) {
+                let l = match map.iter().position(|&x| x == v) {
+                    Some(l) => l,
+                    None => {
+                        map.push(v);
+                        map.len() - 1
+                    }
+                };
+                verts.push(l as u32);
+            }
+            offsets.push(verts.len() as u32);
+        }
+        Ring {
+            faces,
+            map,
+            offsets,
+            verts,
+        }
+    }
+
+    /// Everything the local subdivision of the ring's patch depends on
+    /// besides `map`: the local topology, the sharpness of every face's
+    /// edges (in face order) and of every local vertex. Rings with equal
+    /// keys give equal [`LocalPatch`]es up to `cols`, so they refine to
+    /// equal weights. (The rim edges' sharpness is keyed too although the
+    /// sub-mesh overrides it: rare extra keys, never a false match.)
+    pub(crate) fn shape_key(&self, level: &Level, sharp: &Sharpness) -> Vec<u64> {
+        let mut key = Vec::with_capacity(
+            1 + self.offsets.len() + 2 * self.verts.len() + self.map.len(),
+        );
+        key.push(self.map.len() as u64);
+        key.extend(self.offsets.iter().chain(&self.verts).map(|&x| x as u64));
+        key.extend(
+            self.faces
+                .iter()
+                .flat_map(|&g| level.face_edge_list(g as usize))
+                .map(|&e| sharp.edge[e as usize].to_bits()),
+        );
+        key.extend(self.map.iter().map(|&v| sharp.vertex[v as usize].to_bits()));
+        key
+    }
+
+    /// The ring as a level of its own with its sharpness (rim edges marked
+    /// infinitely sharp so rim vertices stay well defined) and the local
+    /// index of the face (0), and the map local vertex → vertex of `level`.
+    fn sub_mesh(self, level: &Level, sharp: &Sharpness) -> ((Level, Sharpness, u32), Vec<u32>) {
+        let map = self.map;
+        let sub = Level::from_faces(map.len(), &self.offsets, &self.verts)
+            .expect("a sub-mesh of a valid level is valid");
+        let edge = sub
+            .edge_verts
+            .iter()
+            .enumerate()
+            .map(|(e, &[a, b])| {
+                if sub.is_boundary_edge(e) {
+                    SHARPNESS_INFINITE
+                } else {
+                    find_edge(level, map[a as usize], map[b as usize])
+                        .map_or(0.0, |g| sharp.edge[g])
+                }
+            })
+            .collect();
+        let vertex = map.iter().map(|&v| sharp.vertex[v as usize]).collect();
+        ((sub, Sharpness { edge, vertex }, 0), map)
+    }
 }
 
 /// Parameter position of corner `k` of a quad.

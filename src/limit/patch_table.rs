@@ -33,7 +33,7 @@ use crate::topology::{Level, Sharpness};
 
 use super::bspline::{cubic_basis, patch_weights};
 use super::patch::{
-    CORNERS, LocalPatch, SampleStencil, child_frame, evaluate_face, evaluate_local, mat_mul,
+    CORNERS, LocalPatch, Ring, SampleStencil, child_frame, evaluate_face, evaluate_local, mat_mul,
     mat_vec, patch_grid, quadrant,
 };
 use super::vertex_masks::{CornerKind, corner_kind};
@@ -60,7 +60,7 @@ struct Patch {
 struct Tree {
     cols: Vec<u32>,
     /// The leaves, shared by the faces of one structure.
-    leaves: Arc<Vec<Leaf>>,
+    shape: Arc<Shape>,
     /// Each leaf's control points at the current positions, made on first
     /// use (cleared by `set_positions`).
     points: Vec<OnceLock<Box<[Point3; 16]>>>,
@@ -71,7 +71,7 @@ impl Tree {
     /// leaf's own `(s', t')` (clamped to the unit square); `None` in the
     /// innermost cell at the irregular vertex.
     fn leaf_at(&self, st: [Real; 2]) -> Option<(usize, &Leaf, &[Real], [Real; 2])> {
-        self.leaves.iter().enumerate().find_map(|(i, leaf)| {
+        self.shape.leaves.iter().enumerate().find_map(|(i, leaf)| {
             let x = leaf.local(st)?;
             Some((i, leaf, &leaf.grid.as_ref()?[..], x))
         })
@@ -80,7 +80,7 @@ impl Tree {
     /// The innermost cell holding `(s, t)` (where [`leaf_at`](Self::leaf_at)
     /// finds none), and the point in its `(s', t')`.
     fn cell_at(&self, st: [Real; 2]) -> Option<(&Leaf, &LocalPatch, [Real; 2])> {
-        self.leaves.iter().find_map(|leaf| {
+        self.shape.leaves.iter().find_map(|leaf| {
             let x = leaf.local(st)?;
             Some((leaf, leaf.cell.as_ref()?, x))
         })
@@ -146,7 +146,7 @@ pub struct PatchTable {
 }
 
 /// Quadtree leaves by the one-ring's local structure
-/// (`LocalPatch::shape_key`): irregular faces with the same structure
+/// (`Ring::shape_key`): irregular faces with the same structure
 /// (most faces at extraordinary vertices of one valence) share their
 /// weights, which depend on nothing else. Every [`PatchTable`] keeps one;
 /// tables built one after the other over related meshes (the levels of a
@@ -155,8 +155,15 @@ pub struct PatchTable {
 #[derive(Clone, Default)]
 pub struct QuadtreeCache(Arc<Mutex<Shapes>>);
 
-/// Leaves by [`LocalPatch::shape_key`].
-type Shapes = HashMap<Vec<u64>, Arc<Vec<Leaf>>>;
+/// Leaves by `Ring::shape_key`.
+type Shapes = HashMap<Vec<u64>, Arc<Shape>>;
+
+/// The quadtree leaves of one local structure and the structure's number
+/// in its [`QuadtreeCache`] (the order it was first met in).
+struct Shape {
+    id: usize,
+    leaves: Vec<Leaf>,
+}
 
 impl std::fmt::Debug for QuadtreeCache {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -453,16 +460,17 @@ impl PatchTable {
     /// For a patch at an irregular vertex: the level-`L` vertices its
     /// stencils use, in the order of its quadtree (the columns of
     /// [`stencils`](Self::stencils) wherever the quadtree answers), and the
-    /// key of its local structure (topology, sharpness, face followed).
-    /// Patches with equal keys have the same stencils at the same `(s, t)`
-    /// up to that column order. `None` for a regular patch.
-    pub fn irregular_shape(&self, f: usize) -> Option<(Vec<u32>, Vec<u64>)> {
-        if self.patches[f].regular {
+    /// number of its local structure (topology, sharpness, face followed)
+    /// in the table's [`QuadtreeCache`]. Patches with equal numbers have
+    /// the same stencils at the same `(s, t)` up to that column order.
+    /// `None` for a regular patch. Builds (and keeps) the quadtree.
+    pub fn irregular_shape(&self, f: usize) -> Option<(&[u32], usize)> {
+        let patch = &self.patches[f];
+        if patch.regular {
             return None;
         }
-        let root = LocalPatch::around(&self.level, &self.sharp, f);
-        let key = root.shape_key();
-        Some((root.cols, key))
+        let tree = patch.tree.get_or_init(|| self.tree(f));
+        Some((&tree.cols, tree.shape.id))
     }
 
     /// The 16 bicubic B-spline control points of patch `f` as rows over the
@@ -492,7 +500,7 @@ impl PatchTable {
             return vec![([[1.0, 0.0], [0.0, 1.0]], [0.0, 0.0])];
         }
         let tree = patch.tree.get_or_init(|| self.tree(f));
-        tree.leaves.iter().map(|l| (l.jac, l.off)).collect()
+        tree.shape.leaves.iter().map(|l| (l.jac, l.off)).collect()
     }
 
     /// The base-face sample of patch `f` at `(s, t)`.
@@ -612,22 +620,29 @@ impl PatchTable {
     }
 
     /// The quadtree of irregular level-`L` face `f` (see module docs).
+    /// The local patch is built only for a structure not met before; the
+    /// first structure stored under a key is the one every tree shares.
     fn tree(&self, f: usize) -> Tree {
-        let root = LocalPatch::around(&self.level, &self.sharp, f);
-        let cols = root.cols.clone();
-        let key = root.shape_key();
-        let cached = self.shapes.0.lock().ok().and_then(|s| s.get(&key).cloned());
+        let ring = Ring::of(&self.level, f);
+        let key = ring.shape_key(&self.level, &self.sharp);
+        let cols = ring.map.clone();
+        // A poisoned lock (a panic elsewhere while it was held) still
+        // guards a consistent map: an insertion is one call.
+        let shapes = || self.shapes.0.lock().unwrap_or_else(|e| e.into_inner());
+        let cached = shapes().get(&key).cloned();
         let shape = cached.unwrap_or_else(|| {
-            let shape = Arc::new(Self::leaves(root));
-            if let Ok(mut shapes) = self.shapes.0.lock() {
-                shapes.insert(key, shape.clone());
-            }
-            shape
+            let leaves = Self::leaves(LocalPatch::of_ring(&self.level, &self.sharp, ring));
+            let mut shapes = shapes();
+            let id = shapes.len();
+            shapes
+                .entry(key)
+                .or_insert_with(|| Arc::new(Shape { id, leaves }))
+                .clone()
         });
         Tree {
             cols,
-            points: shape.iter().map(|_| OnceLock::new()).collect(),
-            leaves: shape,
+            points: shape.leaves.iter().map(|_| OnceLock::new()).collect(),
+            shape,
         }
     }
 
