@@ -59,9 +59,12 @@ impl PatchAssembly {
         let level = table.level();
         let s = table.to_level();
         let n = s.num_cols;
+        // Per thread: `seen[c]` is the last patch whose support took control
+        // point `c`, `at[c]` its position there.
+        let scratch = || (vec![u32::MAX; n], vec![0u32; n]);
         let rings: Vec<(Vec<u32>, Vec<u32>, Vec<u16>)> = (0..table.num_patches())
             .into_par_iter()
-            .map(|f| {
+            .map_init(scratch, |(seen, at), f| {
                 let mut ring = Vec::with_capacity(16);
                 for &v in level.face_vertices(f) {
                     for &g in level.vertex_faces(v as usize) {
@@ -70,19 +73,25 @@ impl PatchAssembly {
                 }
                 ring.sort_unstable();
                 ring.dedup();
-                let mut sup: Vec<u32> = ring
-                    .iter()
-                    .flat_map(|&w| s.row(w as usize).0)
-                    .copied()
-                    .collect();
+                let mut sup: Vec<u32> = Vec::with_capacity(32);
+                for &w in &ring {
+                    for &c in s.row(w as usize).0 {
+                        if seen[c as usize] != f as u32 {
+                            seen[c as usize] = f as u32;
+                            sup.push(c);
+                        }
+                    }
+                }
                 sup.sort_unstable();
-                sup.dedup();
+                for (i, &c) in sup.iter().enumerate() {
+                    at[c as usize] = i as u32;
+                }
                 // Where each ring vertex's row of S sits in the support
                 // (checked below to fit in u16).
                 let at: Vec<u16> = ring
                     .iter()
                     .flat_map(|&w| s.row(w as usize).0)
-                    .map(|c| sup.binary_search(c).unwrap_or(0) as u16)
+                    .map(|&c| at[c as usize] as u16)
                     .collect();
                 (ring, sup, at)
             })
@@ -128,16 +137,22 @@ impl PatchAssembly {
         }
         let rows: Vec<Vec<u32>> = (0..n)
             .into_par_iter()
-            .map(|c| {
-                let mut row: Vec<u32> = patches_of[count[c]..count[c + 1]]
-                    .iter()
-                    .flat_map(|&f| &supports[f as usize])
-                    .copied()
-                    .collect();
-                row.sort_unstable();
-                row.dedup();
-                row
-            })
+            .map_init(
+                || vec![u32::MAX; n],
+                |seen, c| {
+                    let mut row: Vec<u32> = Vec::with_capacity(64);
+                    for &f in &patches_of[count[c]..count[c + 1]] {
+                        for &b in &supports[f as usize] {
+                            if seen[b as usize] != c as u32 {
+                                seen[b as usize] = c as u32;
+                                row.push(b);
+                            }
+                        }
+                    }
+                    row.sort_unstable();
+                    row
+                },
+            )
             .collect();
         let offsets = offsets_of(rows.iter().map(Vec::len));
         let indices = rows.concat();

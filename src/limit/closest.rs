@@ -304,11 +304,20 @@ impl ClosestPointEngine {
                 queries.len()
             )));
         }
-        queries
+        // In the order of the starts' patches: queries on one patch read
+        // the same control points and quadtree, which then stay in cache
+        // (the callers' points come in any order, often shuffled).
+        let mut order: Vec<u32> = (0..queries.len() as u32).collect();
+        order.sort_unstable_by_key(|&i| starts[i as usize].0);
+        let found: Vec<ClosestPoint> = order
             .par_iter()
-            .zip(starts)
-            .map(|(&q, &s)| query(q, s))
-            .collect()
+            .map(|&i| query(queries[i as usize], starts[i as usize]))
+            .collect::<Result<_>>()?;
+        let mut out = found.clone();
+        for (&i, c) in order.iter().zip(found) {
+            out[i as usize] = c;
+        }
+        Ok(out)
     }
 
     /// Closest points of many queries, in parallel.

@@ -226,9 +226,8 @@ impl Ring {
     /// equal weights. (The rim edges' sharpness is keyed too although the
     /// sub-mesh overrides it: rare extra keys, never a false match.)
     pub(crate) fn shape_key(&self, level: &Level, sharp: &Sharpness) -> Vec<u64> {
-        let mut key = Vec::with_capacity(
-            1 + self.offsets.len() + 2 * self.verts.len() + self.map.len(),
-        );
+        let mut key =
+            Vec::with_capacity(1 + self.offsets.len() + 2 * self.verts.len() + self.map.len());
         key.push(self.map.len() as u64);
         key.extend(self.offsets.iter().chain(&self.verts).map(|&x| x as u64));
         key.extend(

@@ -82,7 +82,7 @@ impl Tree {
     fn cell_at(&self, st: [Real; 2]) -> Option<(&Leaf, &LocalPatch, [Real; 2])> {
         self.shape.leaves.iter().find_map(|leaf| {
             let x = leaf.local(st)?;
-            Some((leaf, leaf.cell.as_ref()?, x))
+            Some((leaf, &**leaf.cell.as_ref()?, x))
         })
     }
 }
@@ -109,7 +109,7 @@ struct Leaf {
     jac: [[Real; 2]; 2],
     off: [Real; 2],
     grid: Option<Vec<Real>>,
-    cell: Option<LocalPatch>,
+    cell: Option<Box<LocalPatch>>,
 }
 
 /// A bicubic piece's control points, the point in the piece's own
@@ -574,16 +574,17 @@ impl PatchTable {
         match self.bicubic_piece(f, st) {
             Some((grid, x, _)) => {
                 let (bs, bt) = (cubic_basis(x[0])[0], cubic_basis(x[1])[0]);
-                Ok(Point3::from(
-                    (0..4)
-                        .map(|a| {
-                            bs[a]
-                                * (0..4)
-                                    .map(|b| bt[b] * grid[4 * a + b].coords)
-                                    .sum::<Vector3>()
-                        })
-                        .sum::<Vector3>(),
-                ))
+                let mut p = [0.0; 3];
+                for (row, ws) in grid.chunks_exact(4).zip(bs) {
+                    for (x, p) in p.iter_mut().enumerate() {
+                        *p += ws
+                            * (bt[0] * row[0][x]
+                                + bt[1] * row[1][x]
+                                + bt[2] * row[2][x]
+                                + bt[3] * row[3][x]);
+                    }
+                }
+                Ok(Point3::from(p))
             }
             None => Ok(self.eval(f, st)?.p),
         }
@@ -607,13 +608,14 @@ impl PatchTable {
         let nc = cols.len().max(1);
         let grid = tree.points[i].get_or_init(|| {
             Box::new(std::array::from_fn(|k| {
-                Point3::from(
-                    rows[k * nc..(k + 1) * nc]
-                        .iter()
-                        .zip(cols)
-                        .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
-                        .sum::<Vector3>(),
-                )
+                let mut p = [0.0; 3];
+                for (&w, &c) in rows[k * nc..(k + 1) * nc].iter().zip(cols) {
+                    let q = &self.level_positions[c as usize];
+                    p[0] += w * q.x;
+                    p[1] += w * q.y;
+                    p[2] += w * q.z;
+                }
+                Point3::from(p)
             }))
         });
         Some((grid, x, Some(leaf.jac)))
@@ -656,7 +658,7 @@ impl PatchTable {
                     jac,
                     off,
                     grid: None,
-                    cell: Some(patch),
+                    cell: Some(Box::new(patch)),
                 });
                 continue;
             }
@@ -705,12 +707,23 @@ fn builders_to_stencil(b: &[RowBuilder; 6]) -> SampleStencil {
 /// Bicubic B-spline patch value and derivatives at `(s, t)`.
 fn bicubic(grid: &[Point3; 16], st: [Real; 2]) -> PatchPoint {
     // The weights of `patch_weights`, as a tensor product: first along `t`
-    // (`c[k][a]`, derivative order `k` in `t`), then along `s`.
+    // (`c[k][a]`, derivative order `k` in `t`), then along `s`. Written out
+    // on plain coordinates: this is the inner loop of every closest-point
+    // descent.
     let (bs, bt) = (cubic_basis(st[0]), cubic_basis(st[1]));
-    let c: [[Vector3; 4]; 3] = std::array::from_fn(|k| {
-        std::array::from_fn(|a| (0..4).map(|b| bt[k][b] * grid[4 * a + b].coords).sum())
-    });
-    let along = |ds: usize, dt: usize| -> Vector3 { (0..4).map(|a| bs[ds][a] * c[dt][a]).sum() };
+    let mut c = [[[0.0; 3]; 4]; 3];
+    for (a, row) in grid.chunks_exact(4).enumerate() {
+        for (k, w) in bt.iter().enumerate() {
+            for x in 0..3 {
+                c[k][a][x] =
+                    w[0] * row[0][x] + w[1] * row[1][x] + w[2] * row[2][x] + w[3] * row[3][x];
+            }
+        }
+    }
+    let along = |ds: usize, dt: usize| -> Vector3 {
+        let (w, c) = (&bs[ds], &c[dt]);
+        Vector3::from_fn(|x, _| w[0] * c[0][x] + w[1] * c[1][x] + w[2] * c[2][x] + w[3] * c[3][x])
+    };
     PatchPoint {
         p: Point3::from(along(0, 0)),
         d: [
