@@ -284,8 +284,8 @@ impl PatchAssembly {
                     let n = self.support_of_block(b).len();
                     if block != Some(b) {
                         if let Some(done) = block {
-                            for (c, v) in c.iter().zip(&mut values) {
-                                self.scatter(done, c, v);
+                            for (c, v) in c.iter_mut().zip(&mut values) {
+                                self.scatter_upper(done, c, v);
                             }
                         }
                         block = Some(b);
@@ -305,11 +305,14 @@ impl PatchAssembly {
                                 }
                             }
                         }
+                        // C is symmetric: its upper triangle only, mirrored
+                        // when the block is scattered.
                         for (i, (w, at)) in rows.iter().enumerate() {
                             for (&x, &a) in w.iter().zip(*at) {
                                 let a = a as usize;
-                                for (o, &y) in
-                                    c[a * n..(a + 1) * n].iter_mut().zip(&t[i * n..(i + 1) * n])
+                                for (o, &y) in c[a * n + a..(a + 1) * n]
+                                    .iter_mut()
+                                    .zip(&t[i * n + a..(i + 1) * n])
                                 {
                                     *o += x * y;
                                 }
@@ -318,8 +321,8 @@ impl PatchAssembly {
                     }
                 }
                 if let Some(done) = block {
-                    for (c, v) in c.iter().zip(&mut values) {
-                        self.scatter(done, c, v);
+                    for (c, v) in c.iter_mut().zip(&mut values) {
+                        self.scatter_upper(done, c, v);
                     }
                 }
                 Ok(values)
@@ -411,11 +414,18 @@ impl PatchAssembly {
         &self.support[self.support_offsets[b]..self.support_offsets[b + 1]]
     }
 
-    /// Adds block `b`'s dense `m × m` sum `c` (row-major over its support) to
-    /// `values` through its slots.
-    fn scatter(&self, b: usize, c: &[Real], values: &mut [Real]) {
+    /// Adds the symmetric `m × m` matrix whose upper triangle is in `c`
+    /// (row-major over block `b`'s support; the lower is overwritten) to
+    /// `values` through the block's slots.
+    fn scatter_upper(&self, b: usize, c: &mut [Real], values: &mut [Real]) {
+        let m = self.support_of_block(b).len();
+        for a in 0..m {
+            for e in a + 1..m {
+                c[e * m + a] = c[a * m + e];
+            }
+        }
         let slots = &self.slots[self.slot_offsets[b]..self.slot_offsets[b + 1]];
-        for (&slot, &x) in slots.iter().zip(c) {
+        for (&slot, &x) in slots.iter().zip(c.iter()) {
             values[slot as usize] += x;
         }
     }
@@ -452,23 +462,13 @@ impl PatchAssembly {
                 let mut rhs = vec![Point3::origin(); n];
                 let mut energy = 0.0;
                 let (mut u, mut c, mut block) = (Vec::new(), Vec::new(), None);
-                // Block `b`'s upper triangle, mirrored into its slots.
-                let flush = |b: usize, c: &mut [Real], values: &mut [Real]| {
-                    let m = self.support_of_block(b).len();
-                    for a in 0..m {
-                        for e in a + 1..m {
-                            c[e * m + a] = c[a * m + e];
-                        }
-                    }
-                    self.scatter(b, c, values);
-                };
                 for &(b, i) in ids {
                     let b = b as usize;
                     let sup = self.support_of_block(b);
                     let m = sup.len();
                     if block != Some(b) {
                         if let Some(done) = block {
-                            flush(done, &mut c, &mut values);
+                            self.scatter_upper(done, &mut c, &mut values);
                         }
                         block = Some(b);
                         c.clear();
@@ -496,7 +496,7 @@ impl PatchAssembly {
                     }
                 }
                 if let Some(done) = block {
-                    flush(done, &mut c, &mut values);
+                    self.scatter_upper(done, &mut c, &mut values);
                 }
                 Ok((values, rhs, energy))
             })

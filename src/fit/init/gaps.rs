@@ -48,11 +48,25 @@ pub fn narrow_gap(
         .zip(normals)
         .step_by(stride)
         .filter_map(|(p, n)| {
-            (1..=steps).map(|i| i as Real * step).find(|&t| {
+            // Step `i` is tried unless a nearest distance `d` seen at step
+            // `j` rules it out: every point is at least `d − (i − j) step`
+            // from step `i`, so it cannot be within `hit` while that is
+            // larger (the same answer as trying every step, in fewer
+            // queries where the march crosses free space).
+            let mut i = 1;
+            while i <= steps {
+                let t = i as Real * step;
                 let x = p + n * t;
                 let nn = tree.nearest_one::<SquaredEuclidean>(&[x.x, x.y, x.z]);
-                nn.distance <= hit * hit && normals[nn.item as usize].dot(n) < -0.7
-            })
+                if nn.distance <= hit * hit && normals[nn.item as usize].dot(n) < -0.7 {
+                    return Some(t);
+                }
+                // The first step that may be within `hit`: `(i' − i) step ≥
+                // d − hit` (less a hair, for round-off).
+                let skip = (nn.distance.sqrt() - hit) / step - 1e-9;
+                i += (skip.ceil() as usize).max(1);
+            }
+            None
         })
         .collect();
     if gaps.len() < MIN_HITS {
