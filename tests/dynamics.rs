@@ -579,9 +579,8 @@ fn patch_assembly_equals_the_sparse_spring_products() {
             .collect();
         let kr: Vec<Real> = (0..at.len()).map(|_| lcg(&mut seed)).collect();
         let reference = row_springs(&rows, &x, &d, &kr).unwrap();
-        let fast = assembly
-            .row_springs(&rows, |i| at[i].0, &x, &d, &kr)
-            .unwrap();
+        let on_patches = assembly.rows_on_patches(rows.clone(), |i| at[i].0).unwrap();
+        let fast = assembly.row_springs(&on_patches, &x, &d, &kr).unwrap();
         let (worst, m) = table_difference(&reference.matrix, &fast.matrix);
         assert!(
             m > 0.0 && worst <= 1e-12 * m,
@@ -621,10 +620,8 @@ fn patch_assembly_equals_the_sparse_spring_products() {
     let row = row.compose(table.to_level()).unwrap();
     let x = row.apply(&grid.positions).unwrap();
     let last = table.num_patches() - 1;
-    assert!(assembly.row_springs(&row, |_| 0, &x, &x, &[1.0]).is_ok());
-    assert!(
-        assembly
-            .row_springs(&row, |_| last, &x, &x, &[1.0])
-            .is_err()
-    );
+    let on_first = assembly.rows_on_patches(row.clone(), |_| 0).unwrap();
+    assert!(assembly.row_springs(&on_first, &x, &x, &[1.0]).is_ok());
+    assert!(assembly.rows_on_patches(row.clone(), |_| last).is_err());
+    assert!(assembly.rows_on_patches(row, |_| last + 1).is_err());
 }

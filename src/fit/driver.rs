@@ -185,8 +185,11 @@ pub fn fit_point_cloud(
         } else {
             None
         };
-        let centres = surface_samples(table, params.surface_samples).compose(s)?;
         let per_patch = params.surface_samples * params.surface_samples;
+        let centres = assembly.rows_on_patches(
+            surface_samples(table, params.surface_samples).compose(s)?,
+            |i| i / per_patch,
+        )?;
         let setup_seconds = level_start.elapsed().as_secs_f64();
         let mut p = mesh.positions.clone();
         // The previous step's positions (at rest when a level starts).
@@ -251,7 +254,7 @@ pub fn fit_point_cloud(
             // closest to (bridges across gaps, flaps) are pulled onto the
             // data too. Huber weights bound the pull.
             let surface = if params.surface_weight > 0.0 {
-                let xs = centres.apply(&p)?;
+                let xs = centres.rows().apply(&p)?;
                 let near: Vec<(Point3, Real)> = xs
                     .par_iter()
                     .map(|x| {
@@ -299,13 +302,7 @@ pub fn fit_point_cloud(
             }
             let mut springs = assembly.data_springs(engine.table(), used, &closest, &kw)?;
             if let Some((xs, targets, ks, _)) = &surface {
-                springs.add(&assembly.row_springs(
-                    &centres,
-                    |i| i / per_patch,
-                    xs,
-                    targets,
-                    ks,
-                )?)?;
+                springs.add(&assembly.row_springs(&centres, xs, targets, ks)?)?;
             }
             let mut a = springs.matrix;
             for (x, y) in a.weights.iter_mut().zip(&kd_values) {

@@ -387,27 +387,68 @@ impl PatchAssembly {
         )
     }
 
-    /// Springs from surface points `x[i] = rows[i] · p` on patches
-    /// `patch_of(i)` to targets `d[i]` with stiffness `k[i]`: the system of
+    /// `rows` (over the control points), row `i` a point on patch
+    /// `patch_of(i)`, with every entry's place in that patch's support
+    /// looked up once: for springs that stay on their patches step after
+    /// step ([`row_springs`](Self::row_springs)). Errors when a row leaves
+    /// its patch's support or names a patch out of range.
+    pub fn rows_on_patches(
+        &self,
+        rows: StencilTable,
+        patch_of: impl Fn(usize) -> usize + Sync,
+    ) -> Result<PatchRows> {
+        let patches = self.block.len();
+        let per_row: Vec<(u32, Vec<u16>)> = (0..rows.num_rows())
+            .into_par_iter()
+            .map(|i| {
+                let f = patch_of(i);
+                if f >= patches {
+                    return Err(Error::Input(format!(
+                        "row {i} is on patch {f} of {patches}"
+                    )));
+                }
+                let sup = self.support_of_block(self.block[f] as usize);
+                let at = rows
+                    .row(i)
+                    .0
+                    .iter()
+                    .map(|&c| position(sup, c).map(|p| p as u16))
+                    .collect::<Result<_>>()?;
+                Ok((f as u32, at))
+            })
+            .collect::<Result<_>>()?;
+        let (patch, at): (Vec<u32>, Vec<Vec<u16>>) = per_row.into_iter().unzip();
+        Ok(PatchRows {
+            rows,
+            patch,
+            at: at.concat(),
+        })
+    }
+
+    /// Springs from surface points `x[i] = rows[i] · p` to targets `d[i]`
+    /// with stiffness `k[i]`: the system of
     /// [`row_springs`](super::row_springs), its matrix in the pattern.
     pub fn row_springs(
         &self,
-        rows: &StencilTable,
-        patch_of: impl Fn(usize) -> usize + Sync,
+        rows: &PatchRows,
         x: &[Point3],
         d: &[Point3],
         k: &[Real],
     ) -> Result<SpringSystem> {
-        check_lengths(rows.num_rows(), x.len(), d.len())?;
-        check_lengths(rows.num_rows(), k.len(), d.len())?;
-        self.springs(d.len(), patch_of, |i, f, u| {
-            let sup = self.support_of_block(self.block[f] as usize);
-            let (cols, ws) = rows.row(i);
-            for (&c, &w) in cols.iter().zip(ws) {
-                u[position(sup, c)?] += w;
-            }
-            Ok((x[i], d[i], k[i]))
-        })
+        let r = &rows.rows;
+        check_lengths(r.num_rows(), x.len(), d.len())?;
+        check_lengths(r.num_rows(), k.len(), d.len())?;
+        self.springs(
+            d.len(),
+            |i| rows.patch[i] as usize,
+            |i, _, u| {
+                let (lo, hi) = (r.offsets[i], r.offsets[i + 1]);
+                for (&a, &w) in rows.at[lo..hi].iter().zip(&r.weights[lo..hi]) {
+                    u[a as usize] += w;
+                }
+                Ok((x[i], d[i], k[i]))
+            },
+        )
     }
 
     fn support_of_block(&self, b: usize) -> &[u32] {
@@ -517,6 +558,24 @@ impl PatchAssembly {
             rhs,
             energy,
         })
+    }
+}
+
+/// Rows over the control points on known patches of a [`PatchAssembly`]
+/// ([`PatchAssembly::rows_on_patches`]).
+#[derive(Clone, Debug)]
+pub struct PatchRows {
+    rows: StencilTable,
+    /// Each row's patch.
+    patch: Vec<u32>,
+    /// Each entry's place in its row's patch support.
+    at: Vec<u16>,
+}
+
+impl PatchRows {
+    /// The rows.
+    pub fn rows(&self) -> &StencilTable {
+        &self.rows
     }
 }
 
