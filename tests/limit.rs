@@ -1259,3 +1259,64 @@ fn patch_position_equals_the_evaluated_point() {
         }
     }
 }
+
+/// Quadtree structures are keyed by the topology around a face, not by how
+/// the mesh numbers its faces: the same meshes with their faces listed in
+/// reverse order, each face's corners rotated by one, need exactly as many
+/// structures, and every table evaluates the exact limit surface
+/// ([`LimitEvaluator`]) at random points of every patch.
+#[test]
+fn quadtree_structures_do_not_depend_on_face_numbering() {
+    let mut rng = Rng::new(11);
+    for (mesh, name) in [
+        (pentagonal_pyramid(), "pentagonal pyramid"),
+        (mixed_mesh(), "mixed mesh"),
+        (subdyn::examples::cube(), "cube"),
+        (refined_cube(), "cube refined twice"),
+    ] {
+        let faces: Vec<Vec<u32>> = (0..mesh.num_faces())
+            .rev()
+            .map(|f| {
+                let mut c = mesh.face(f).to_vec();
+                c.rotate_left(1);
+                c
+            })
+            .collect();
+        let relisted = PolyMesh::from_faces(mesh.positions.clone(), &faces).unwrap();
+        let mut counts = Vec::new();
+        for m in [&mesh, &relisted] {
+            let cache = subdyn::limit::QuadtreeCache::default();
+            let r = default_refiner(m);
+            let table = PatchTable::with_quadtrees(&r, &m.positions, 1, cache.clone()).unwrap();
+            let exact = LimitEvaluator::new(&r);
+            let scale = diag(&m.positions);
+            for f in 0..table.num_patches() {
+                let st = [rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0)];
+                let a = table.eval(f, st).unwrap().p;
+                let s = table.sample(f, st);
+                let b = exact
+                    .evaluate(s.face as usize, s.u, s.v, &m.positions)
+                    .unwrap()
+                    .p;
+                assert!(
+                    (a - b).norm() <= 1e-12 * scale,
+                    "{name}: patch {f} at {st:?}: {a} against {b}"
+                );
+            }
+            counts.push(format!("{cache:?}"));
+        }
+        assert_eq!(counts[0], counts[1], "{name}");
+    }
+}
+
+/// The cube refined twice: 96 quads, its 8 valence-3 corners far apart.
+fn refined_cube() -> PolyMesh {
+    let cube = subdyn::examples::cube();
+    let h = default_refiner(&cube).refine_uniform(2).unwrap();
+    let p = h
+        .stencil_to_level(2)
+        .unwrap()
+        .apply(&cube.positions)
+        .unwrap();
+    h.mesh(2, p)
+}

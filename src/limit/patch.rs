@@ -16,7 +16,7 @@
 use crate::math::Real;
 use crate::stencil::RowBuilder;
 use crate::subdivision::{refine_stencil, refine_topology};
-use crate::topology::{Level, SHARPNESS_INFINITE, Sharpness, VertexRule, find_edge};
+use crate::topology::{Level, NONE, SHARPNESS_INFINITE, Sharpness, VertexRule, find_edge};
 
 use super::bspline::patch_weights;
 use super::patch_table::chain;
@@ -177,8 +177,18 @@ impl LocalPatch {
 /// The faces sharing a vertex with a face of a level (that face first) and
 /// their corners in a local numbering: `map[l]` is local vertex `l`'s vertex
 /// of the level, face `i` has local corners `verts[offsets[i]..offsets[i + 1]]`.
+///
+/// The order depends on the topology alone, not on how the level numbers
+/// its faces, so that rings of the same structure get the same
+/// [`shape_key`](Self::shape_key): the faces around each corner of the face
+/// (in its corner order) are taken in rotational order starting from the
+/// face, and each face's corners are listed from the corner it was reached
+/// through (the face itself from its corner 0). Rotating a neighbour's
+/// corner list keeps its orientation, so the sub-mesh is the same surface.
 pub(crate) struct Ring {
     faces: Vec<u32>,
+    /// Each face's first corner (an index into its corner list).
+    firsts: Vec<usize>,
     pub(crate) map: Vec<u32>,
     offsets: Vec<u32>,
     verts: Vec<u32>,
@@ -188,18 +198,22 @@ impl Ring {
     /// The ring of `face` in `level`.
     pub(crate) fn of(level: &Level, face: usize) -> Ring {
         let mut faces: Vec<u32> = vec![face as u32];
+        let mut firsts = vec![0];
         for &v in level.face_vertices(face) {
-            for &g in level.vertex_faces(v as usize) {
+            for g in faces_around(level, face, v) {
                 if !faces.contains(&g) {
+                    let k = level.face_vertices(g as usize).iter().position(|&w| w == v);
                     faces.push(g);
+                    firsts.push(k.unwrap_or(0));
                 }
             }
         }
         let mut map: Vec<u32> = Vec::new();
         let mut offsets = vec![0u32];
         let mut verts = Vec::new();
-        for &g in &faces {
-            for &v in level.face_vertices(g as usize) {
+        for (&g, &first) in faces.iter().zip(&firsts) {
+            let fv = level.face_vertices(g as usize);
+            for &v in fv[first..].iter().chain(&fv[..first]) {
                 let l = match map.iter().position(|&x| x == v) {
                     Some(l) => l,
                     None => {
@@ -213,6 +227,7 @@ impl Ring {
         }
         Ring {
             faces,
+            firsts,
             map,
             offsets,
             verts,
@@ -230,12 +245,15 @@ impl Ring {
             Vec::with_capacity(1 + self.offsets.len() + 2 * self.verts.len() + self.map.len());
         key.push(self.map.len() as u64);
         key.extend(self.offsets.iter().chain(&self.verts).map(|&x| x as u64));
-        key.extend(
-            self.faces
-                .iter()
-                .flat_map(|&g| level.face_edge_list(g as usize))
-                .map(|&e| sharp.edge[e as usize].to_bits()),
-        );
+        for (&g, &first) in self.faces.iter().zip(&self.firsts) {
+            let fe = level.face_edge_list(g as usize);
+            key.extend(
+                fe[first..]
+                    .iter()
+                    .chain(&fe[..first])
+                    .map(|&e| sharp.edge[e as usize].to_bits()),
+            );
+        }
         key.extend(self.map.iter().map(|&v| sharp.vertex[v as usize].to_bits()));
         key
     }
@@ -263,6 +281,44 @@ impl Ring {
         let vertex = map.iter().map(|&v| sharp.vertex[v as usize]).collect();
         ((sub, Sharpness { edge, vertex }, 0), map)
     }
+}
+
+/// The faces at vertex `v` of face `f` in rotational order from `f`: across
+/// the edge into `v`, and on from there; at a boundary also the other way
+/// from `f`. Any face at `v` such a walk misses (a non-manifold fan) comes
+/// last, in the level's order.
+fn faces_around(level: &Level, f: usize, v: u32) -> Vec<u32> {
+    let at_v = level.vertex_faces(v as usize);
+    let mut out = Vec::with_capacity(at_v.len());
+    // `into`: cross the edge ending at `v` (true) or the one starting there.
+    for into in [true, false] {
+        let mut g = f;
+        while out.len() < at_v.len() {
+            let fv = level.face_vertices(g);
+            let Some(i) = fv.iter().position(|&w| w == v) else {
+                break;
+            };
+            let k = if into {
+                (i + fv.len() - 1) % fv.len()
+            } else {
+                i
+            };
+            let e = level.face_edge_list(g)[k] as usize;
+            let [a, b] = level.edge_faces[e];
+            let h = if a as usize == g { b } else { a };
+            if h == NONE || h as usize == f || out.contains(&h) {
+                break;
+            }
+            out.push(h);
+            g = h as usize;
+        }
+    }
+    for &g in at_v {
+        if g as usize != f && !out.contains(&g) {
+            out.push(g);
+        }
+    }
+    out
 }
 
 /// Parameter position of corner `k` of a quad.
