@@ -11,8 +11,9 @@
 //! forming `JᵀJ` by sparse products every step. Consecutive patches with the
 //! same support (a regular control face's four corners at level 1) form one
 //! *block* that shares its slots, and the springs of a block are summed in a
-//! dense buffer (its upper triangle: `JᵀJ` is symmetric) that is scattered
-//! through the slots once. The thin plate's and damping's dense patch
+//! dense buffer that is scattered through the slots once (whole rows: on
+//! two cores that measured faster than the upper triangle alone, whose
+//! rows of varying length vectorise worse). The thin plate's and damping's dense patch
 //! elements are carried to the control points the same way
 //! ([`PatchAssembly::values_of_elements`]). The sums are the same as
 //! [`spring_system`](super::spring_system)'s and the sparse `Sᵀ K_L S`'s to
@@ -284,8 +285,8 @@ impl PatchAssembly {
                     let n = self.support_of_block(b).len();
                     if block != Some(b) {
                         if let Some(done) = block {
-                            for (c, v) in c.iter_mut().zip(&mut values) {
-                                self.scatter_upper(done, c, v);
+                            for (c, v) in c.iter().zip(&mut values) {
+                                self.scatter(done, c, v);
                             }
                         }
                         block = Some(b);
@@ -305,14 +306,11 @@ impl PatchAssembly {
                                 }
                             }
                         }
-                        // C is symmetric: its upper triangle only, mirrored
-                        // when the block is scattered.
                         for (i, (w, at)) in rows.iter().enumerate() {
                             for (&x, &a) in w.iter().zip(*at) {
                                 let a = a as usize;
-                                for (o, &y) in c[a * n + a..(a + 1) * n]
-                                    .iter_mut()
-                                    .zip(&t[i * n + a..(i + 1) * n])
+                                for (o, &y) in
+                                    c[a * n..(a + 1) * n].iter_mut().zip(&t[i * n..(i + 1) * n])
                                 {
                                     *o += x * y;
                                 }
@@ -321,8 +319,8 @@ impl PatchAssembly {
                     }
                 }
                 if let Some(done) = block {
-                    for (c, v) in c.iter_mut().zip(&mut values) {
-                        self.scatter_upper(done, c, v);
+                    for (c, v) in c.iter().zip(&mut values) {
+                        self.scatter(done, c, v);
                     }
                 }
                 Ok(values)
@@ -455,18 +453,11 @@ impl PatchAssembly {
         &self.support[self.support_offsets[b]..self.support_offsets[b + 1]]
     }
 
-    /// Adds the symmetric `m × m` matrix whose upper triangle is in `c`
-    /// (row-major over block `b`'s support; the lower is overwritten) to
-    /// `values` through the block's slots.
-    fn scatter_upper(&self, b: usize, c: &mut [Real], values: &mut [Real]) {
-        let m = self.support_of_block(b).len();
-        for a in 0..m {
-            for e in a + 1..m {
-                c[e * m + a] = c[a * m + e];
-            }
-        }
+    /// Adds block `b`'s dense `m × m` sum `c` (row-major over its support) to
+    /// `values` through its slots.
+    fn scatter(&self, b: usize, c: &[Real], values: &mut [Real]) {
         let slots = &self.slots[self.slot_offsets[b]..self.slot_offsets[b + 1]];
-        for (&slot, &x) in slots.iter().zip(c.iter()) {
+        for (&slot, &x) in slots.iter().zip(c) {
             values[slot as usize] += x;
         }
     }
@@ -475,7 +466,7 @@ impl PatchAssembly {
     /// patches `patch_of(i)`; `spring(i, f, u)` writes spring `i`'s row over
     /// its patch `f`'s support into the zeroed `u` and returns `x`, `d` and
     /// `k`. The springs are taken block by block, each block's `k uuᵀ`
-    /// summed in a dense upper triangle and scattered once.
+    /// summed in a dense buffer and scattered once.
     fn springs(
         &self,
         count: usize,
@@ -509,7 +500,7 @@ impl PatchAssembly {
                     let m = sup.len();
                     if block != Some(b) {
                         if let Some(done) = block {
-                            self.scatter_upper(done, &mut c, &mut values);
+                            self.scatter(done, &c, &mut values);
                         }
                         block = Some(b);
                         c.clear();
@@ -531,13 +522,13 @@ impl PatchAssembly {
                             continue;
                         }
                         rhs[sup[a] as usize].coords += ka * d.coords;
-                        for (o, &y) in c[a * m + a..(a + 1) * m].iter_mut().zip(&u[a..]) {
+                        for (o, &y) in c[a * m..(a + 1) * m].iter_mut().zip(&u[..]) {
                             *o += ka * y;
                         }
                     }
                 }
                 if let Some(done) = block {
-                    self.scatter_upper(done, &mut c, &mut values);
+                    self.scatter(done, &c, &mut values);
                 }
                 Ok((values, rhs, energy))
             })
