@@ -387,6 +387,37 @@ fn pcg_solves_spd_systems_and_reports() {
     for (x, t) in x.iter().zip(&truth) {
         assert!((x - t).norm() < 1e-8, "{x} vs {t}");
     }
+    // The coordinates are independent solves run in lockstep: each takes
+    // exactly the iterates of a solve of its own (the other coordinates
+    // zero), and the report gives the slowest one's iterations.
+    let mixed: Vec<Point3> = b
+        .iter()
+        .map(|p| Point3::new(p.x, 0.0, 1e-3 * p.z))
+        .collect();
+    let mut together = vec![Point3::origin(); a.num_rows()];
+    let report = pcg(&a, &mixed, &mut together, &PcgParams::default()).unwrap();
+    let mut slowest = 0;
+    for k in 0..3 {
+        let alone: Vec<Point3> = mixed
+            .iter()
+            .map(|p| {
+                let mut q = Point3::origin();
+                q[k] = p[k];
+                q
+            })
+            .collect();
+        let mut xk = vec![Point3::origin(); a.num_rows()];
+        slowest = slowest.max(
+            pcg(&a, &alone, &mut xk, &PcgParams::default())
+                .unwrap()
+                .iterations,
+        );
+        assert!(
+            together.iter().zip(&xk).all(|(t, s)| t[k] == s[k]),
+            "coordinate {k}"
+        );
+    }
+    assert_eq!(report.iterations, slowest);
     // K alone is singular (translations): its diagonal is positive but CG on
     // an inconsistent system must not claim convergence silently.
     assert!(

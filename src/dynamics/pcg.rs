@@ -87,73 +87,112 @@ pub fn pcg(
         converged: true,
         seconds: 0.0,
     };
+    let (iterations, relative) = solve(a, &diag, b, x, params.tolerance, max_it)?;
     for k in 0..3 {
-        let bk: Vec<Real> = b.iter().map(|p| p[k]).collect();
-        let mut xk: Vec<Real> = x.iter().map(|p| p[k]).collect();
-        let (it, rel) = solve_scalar(a, &diag, &bk, &mut xk, params.tolerance, max_it)?;
-        for (p, v) in x.iter_mut().zip(&xk) {
-            p[k] = *v;
-        }
-        report.iterations = report.iterations.max(it);
-        report.relative_residual = report.relative_residual.max(rel);
-        report.converged &= rel <= params.tolerance;
+        report.iterations = report.iterations.max(iterations[k]);
+        report.relative_residual = report.relative_residual.max(relative[k]);
+        report.converged &= relative[k] <= params.tolerance;
     }
     report.seconds = start.elapsed().as_secs_f64();
     Ok(report)
 }
 
-fn dot(a: &[Real], b: &[Real]) -> Real {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+/// `Σ_i a_i[k] b_i[k]` for each coordinate `k`.
+fn dots(a: &[Point3], b: &[Point3]) -> [Real; 3] {
+    let mut out = [0.0; 3];
+    for (a, b) in a.iter().zip(b) {
+        for k in 0..3 {
+            out[k] += a[k] * b[k];
+        }
+    }
+    out
 }
 
-/// One coordinate: returns (iterations, relative residual).
-fn solve_scalar(
+/// Three independent CG solves, one per coordinate, run in lockstep so that
+/// each iteration reads the matrix once for all three (the product is
+/// memory-bound). A coordinate stops at its own tolerance and is then left
+/// alone, so each takes exactly the iterates of a solve of its own. Returns
+/// each coordinate's iterations and relative residual.
+fn solve(
     a: &StencilTable,
     diag: &[Real],
-    b: &[Real],
-    x: &mut [Real],
+    b: &[Point3],
+    x: &mut [Point3],
     tol: Real,
     max_it: usize,
-) -> Result<(usize, Real)> {
-    let bnorm = dot(b, b).sqrt();
-    if bnorm == 0.0 {
-        x.fill(0.0);
-        return Ok((0, 0.0));
+) -> Result<([usize; 3], [Real; 3])> {
+    let bnorm = dots(b, b).map(Real::sqrt);
+    let mut done = [false; 3];
+    let mut iterations = [max_it; 3];
+    let mut relative = [0.0; 3];
+    for k in 0..3 {
+        if bnorm[k] == 0.0 {
+            x.iter_mut().for_each(|p| p[k] = 0.0);
+            (done[k], iterations[k]) = (true, 0);
+        }
     }
-    let ax = a.apply_scalar(x)?;
-    let mut r: Vec<Real> = b.iter().zip(&ax).map(|(b, a)| b - a).collect();
-    let mut z: Vec<Real> = r.iter().zip(diag).map(|(r, d)| r / d).collect();
+    let ax = a.apply(x)?;
+    let mut r: Vec<Point3> = b
+        .iter()
+        .zip(&ax)
+        .map(|(b, a)| Point3::from(b - a))
+        .collect();
+    let mut z: Vec<Point3> = r.iter().zip(diag).map(|(r, d)| r / *d).collect();
     let mut p = z.clone();
-    let mut rz = dot(&r, &z);
+    let mut rz = dots(&r, &z);
     for it in 0..max_it {
-        let rel = dot(&r, &r).sqrt() / bnorm;
-        if !rel.is_finite() {
-            return Err(Error::NotConverged(format!(
-                "pcg residual became {rel} at iteration {it}"
-            )));
+        let rr = dots(&r, &r);
+        for k in 0..3 {
+            if done[k] {
+                continue;
+            }
+            let rel = rr[k].sqrt() / bnorm[k];
+            if !rel.is_finite() {
+                return Err(Error::NotConverged(format!(
+                    "pcg residual became {rel} at iteration {it}"
+                )));
+            }
+            if rel <= tol {
+                (done[k], iterations[k], relative[k]) = (true, it, rel);
+            }
         }
-        if rel <= tol {
-            return Ok((it, rel));
+        if done.iter().all(|&d| d) {
+            return Ok((iterations, relative));
         }
-        let ap = a.apply_scalar(&p)?;
-        let pap = dot(&p, &ap);
-        if pap <= 0.0 {
-            return Err(Error::NotConverged(format!(
-                "pcg: pᵀAp = {pap:e} at iteration {it}; the matrix is not positive definite"
-            )));
+        let ap = a.apply(&p)?;
+        let pap = dots(&p, &ap);
+        let mut alpha = [0.0; 3];
+        for k in (0..3).filter(|&k| !done[k]) {
+            if pap[k] <= 0.0 {
+                return Err(Error::NotConverged(format!(
+                    "pcg: pᵀAp = {:e} at iteration {it}; the matrix is not positive definite",
+                    pap[k]
+                )));
+            }
+            alpha[k] = rz[k] / pap[k];
         }
-        let alpha = rz / pap;
         for i in 0..x.len() {
-            x[i] += alpha * p[i];
-            r[i] -= alpha * ap[i];
-            z[i] = r[i] / diag[i];
+            for k in (0..3).filter(|&k| !done[k]) {
+                x[i][k] += alpha[k] * p[i][k];
+                r[i][k] -= alpha[k] * ap[i][k];
+                z[i][k] = r[i][k] / diag[i];
+            }
         }
-        let rz_new = dot(&r, &z);
-        let beta = rz_new / rz;
-        rz = rz_new;
-        for i in 0..p.len() {
-            p[i] = z[i] + beta * p[i];
+        let rz_new = dots(&r, &z);
+        let mut beta = [0.0; 3];
+        for k in (0..3).filter(|&k| !done[k]) {
+            beta[k] = rz_new[k] / rz[k];
+            rz[k] = rz_new[k];
+        }
+        for (p, z) in p.iter_mut().zip(&z) {
+            for k in (0..3).filter(|&k| !done[k]) {
+                p[k] = z[k] + beta[k] * p[k];
+            }
         }
     }
-    Ok((max_it, dot(&r, &r).sqrt() / bnorm))
+    let rr = dots(&r, &r);
+    for k in (0..3).filter(|&k| !done[k]) {
+        relative[k] = rr[k].sqrt() / bnorm[k];
+    }
+    Ok((iterations, relative))
 }
