@@ -81,20 +81,14 @@ pub fn pcg(
     } else {
         params.max_iterations
     };
-    let mut report = PcgReport {
-        iterations: 0,
-        relative_residual: 0.0,
-        converged: true,
-        seconds: 0.0,
-    };
     let (iterations, relative) = solve(a, &diag, b, x, params.tolerance, max_it)?;
-    for k in 0..3 {
-        report.iterations = report.iterations.max(iterations[k]);
-        report.relative_residual = report.relative_residual.max(relative[k]);
-        report.converged &= relative[k] <= params.tolerance;
-    }
-    report.seconds = start.elapsed().as_secs_f64();
-    Ok(report)
+    let relative_residual = relative.into_iter().fold(0.0, Real::max);
+    Ok(PcgReport {
+        iterations: iterations.into_iter().max().unwrap_or(0),
+        relative_residual,
+        converged: relative.iter().all(|&r| r <= params.tolerance),
+        seconds: start.elapsed().as_secs_f64(),
+    })
 }
 
 /// `Σ_i a_i[k] b_i[k]` for each coordinate `k`.
