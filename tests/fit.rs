@@ -289,3 +289,41 @@ fn adaptive_levels_never_end_worse_than_their_parents() {
         u.error.rms
     );
 }
+
+/// The initial model's outlier screening, handed to the fit, gives the same
+/// fit as screening again; a screening of another cloud is refused.
+#[test]
+fn the_initial_models_screening_serves_the_fit() {
+    use subdyn::fit::fit_screened_cloud;
+    use subdyn::fit::init::{InitParams, initial_mesh};
+    let mut cloud = sphere_scan(3000, 0.002, 5);
+    // A few far points for the screening to drop.
+    cloud.positions.extend([
+        Point3::new(3.0, 0.0, 0.0),
+        Point3::new(0.0, -2.5, 1.0),
+        Point3::new(1.5, 1.5, 1.5),
+    ]);
+    let (init, report) = initial_mesh(&cloud, &InitParams::default()).unwrap();
+    let screening = report.screening.expect("an unthinned cloud's screening");
+    assert_eq!(screening.keep.len(), cloud.len());
+    assert_eq!(screening.keep.iter().filter(|&&k| !k).count(), 3);
+    let params = FitParams {
+        max_level: 1,
+        ..Default::default()
+    };
+    let again = fit_point_cloud(&cloud, &init, &params, &mut |_, _, _| {}).unwrap();
+    let reused =
+        fit_screened_cloud(&cloud, Some(&screening), &init, &params, &mut |_, _, _| {}).unwrap();
+    assert_eq!(again.control.positions, reused.control.positions);
+    assert_eq!(again.report.outliers, 3);
+    assert_eq!(reused.report.outliers, 3);
+    let mut other = screening.clone();
+    other.keep.pop();
+    let err = fit_screened_cloud(&cloud, Some(&other), &init, &params, &mut |_, _, _| {})
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("screening of 3002 points for a cloud of 3003"),
+        "{err}"
+    );
+}

@@ -11,7 +11,7 @@ use clap::Args;
 use serde_json::json;
 
 use subdyn::fit::init::{InitParams, initial_mesh};
-use subdyn::fit::{FitParams, FitReport, fit_point_cloud};
+use subdyn::fit::{FitParams, FitReport, fit_screened_cloud};
 use subdyn::io::read_points;
 
 use super::bench::set_threads;
@@ -72,9 +72,16 @@ pub fn bench_fit(args: &BenchFitArgs) -> anyhow::Result<()> {
     for r in 0..args.repeat {
         progress.stage(format!("run {} of {}", r + 1, args.repeat));
         let (init, init_s) = timed(|| initial_mesh(&cloud, &InitParams::default()));
-        let (mesh, _) = init?;
-        let (fit, fit_s) =
-            timed(|| fit_point_cloud(&cloud, &mesh, &FitParams::default(), &mut |_, _, _| {}));
+        let (mesh, init) = init?;
+        let (fit, fit_s) = timed(|| {
+            fit_screened_cloud(
+                &cloud,
+                init.screening.as_ref(),
+                &mesh,
+                &FitParams::default(),
+                &mut |_, _, _| {},
+            )
+        });
         runs.push(Run {
             init_s,
             fit_s,

@@ -8,7 +8,8 @@ use clap::{Args, ValueEnum};
 use serde_json::json;
 
 use subdyn::fit::init::InitParams;
-use subdyn::fit::{FitParams, FitReport, Refinement, ToleranceStat, fit_point_cloud};
+use subdyn::fit::init::outliers::Screening;
+use subdyn::fit::{FitParams, FitReport, Refinement, ToleranceStat, fit_screened_cloud};
 use subdyn::io::{read_points, write_mesh};
 use subdyn::limit::tessellate;
 use subdyn::mesh::{PointCloud, PolyMesh};
@@ -158,12 +159,19 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     };
     check_cloud(&cloud, &name)?;
     progress.stage("building the initial model");
-    let (init, init_report) = initial_model(&args.init, args.init_resolution, &cloud, args.quiet)?;
+    let (init, init_report, screening) =
+        initial_model(&args.init, args.init_resolution, &cloud, args.quiet)?;
     let mut fit_progress = |level: usize, step: usize, energy: f64| {
         progress.stage(format!("level {level}, step {step}: energy {energy:.4e}"));
     };
-    let result = fit_point_cloud(&cloud, &init, &params, &mut fit_progress)
-        .map_err(|e| anyhow::Error::new(e).context(format!("fitting {name}")))?;
+    let result = fit_screened_cloud(
+        &cloud,
+        screening.as_ref(),
+        &init,
+        &params,
+        &mut fit_progress,
+    )
+    .map_err(|e| anyhow::Error::new(e).context(format!("fitting {name}")))?;
     progress.stage(format!("writing {}", args.output.display()));
     write_mesh(&args.output, &result.control, None).map_err(|e| about_file(e, &args.output))?;
     if let Some(path) = &args.limit_out {
@@ -245,13 +253,14 @@ fn check_cloud(cloud: &PointCloud, name: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The initial control mesh: a file, or `auto`.
+/// The initial control mesh: a file, or `auto` (with the cloud's outlier
+/// screening, for the fit to reuse).
 fn initial_model(
     init: &str,
     resolution: usize,
     cloud: &PointCloud,
     quiet: bool,
-) -> anyhow::Result<(PolyMesh, serde_json::Value)> {
+) -> anyhow::Result<(PolyMesh, serde_json::Value, Option<Screening>)> {
     if let Ok(kind) = init.parse::<subdyn::fit::init::InitKind>() {
         let params = InitParams {
             kind,
@@ -266,13 +275,13 @@ fn initial_model(
             "vertices": mesh.num_vertices(),
             "faces": mesh.num_faces(),
         });
-        return Ok((mesh, value));
+        return Ok((mesh, value, report.screening));
     }
     let path = Path::new(init);
     let mesh = read_polygon_mesh(path, quiet)?;
     Refiner::new(&mesh, &RefineOptions::default()).map_err(|e| about_file(e, path))?;
     let value = json!({"method": "file", "path": init, "vertices": mesh.num_vertices(), "faces": mesh.num_faces()});
-    Ok((mesh, value))
+    Ok((mesh, value, None))
 }
 
 fn summary(name: &str, output: &Path, limit: Option<&Path>, r: &FitReport) -> String {

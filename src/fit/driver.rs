@@ -52,7 +52,7 @@ use crate::subdivision::{
 };
 use crate::topology::face_of_corner;
 
-use super::init::outliers::inliers_and_noise;
+use super::init::outliers::{Screening, screen};
 use super::refine_marks::faces_above_noise;
 use super::sampling::{shuffled_order, surface_samples, trimmed_rms};
 use super::{ErrorStats, FitParams, FitReport, LevelReport, Refinement};
@@ -89,6 +89,19 @@ pub fn fit_point_cloud(
     params: &FitParams,
     progress: &mut dyn FnMut(usize, usize, Real),
 ) -> Result<FitResult> {
+    fit_screened_cloud(cloud, None, init, params, progress)
+}
+
+/// [`fit_point_cloud`] with the cloud's outlier screening already done
+/// (`screening`, as [`crate::fit::init::initial_mesh`] reports it; `None`:
+/// screened here). Errors when it is not of the cloud's length.
+pub fn fit_screened_cloud(
+    cloud: &PointCloud,
+    screening: Option<&Screening>,
+    init: &PolyMesh,
+    params: &FitParams,
+    progress: &mut dyn FnMut(usize, usize, Real),
+) -> Result<FitResult> {
     params.check()?;
     let points = &cloud.positions;
     if points.len() < 4 {
@@ -105,7 +118,20 @@ pub fn fit_point_cloud(
     }
     let start = Instant::now();
     // The springs' data: the points without the outliers.
-    let (mut keep, data_noise) = inliers_and_noise(points);
+    let (mut keep, data_noise) = match screening {
+        Some(s) if s.keep.len() != points.len() => {
+            return Err(Error::Input(format!(
+                "an outlier screening of {} points for a cloud of {}",
+                s.keep.len(),
+                points.len()
+            )));
+        }
+        Some(s) => (s.keep.clone(), s.noise),
+        None => {
+            let s = screen(points);
+            (s.keep, s.noise)
+        }
+    };
     if !params.drop_outliers {
         keep.fill(true);
     }

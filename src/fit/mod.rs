@@ -11,6 +11,6 @@ pub mod refine_marks;
 mod report;
 mod sampling;
 
-pub use driver::{FitResult, fit_point_cloud};
+pub use driver::{FitResult, fit_point_cloud, fit_screened_cloud};
 pub use params::{FitParams, Refinement, ToleranceStat};
 pub use report::{ErrorStats, FitReport, LevelReport};

@@ -45,9 +45,24 @@ pub fn patch_weights(s: Real, t: Real) -> [[Real; 16]; 6] {
     w
 }
 
+/// The value row of [`patch_weights`] alone: the 16 weights of the position
+/// of a bicubic B-spline patch at `(s, t)`, the same products.
+pub fn position_weights(s: Real, t: Real) -> [Real; 16] {
+    let [bs, ..] = cubic_basis(s);
+    let [bt, ..] = cubic_basis(t);
+    std::array::from_fn(|k| bs[k / 4] * bt[k % 4])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn position_weights_are_patch_weights_value_row() {
+        for &(s, t) in &[(0.0, 0.0), (0.3, 0.7), (1.0, 0.25)] {
+            assert_eq!(position_weights(s, t), patch_weights(s, t)[0]);
+        }
+    }
 
     #[test]
     fn partition_of_unity_and_derivatives() {

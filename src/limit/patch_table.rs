@@ -31,7 +31,7 @@ use crate::stencil::{RowBuilder, StencilTable};
 use crate::subdivision::{Hierarchy, Refiner};
 use crate::topology::{Level, Sharpness};
 
-use super::bspline::{cubic_basis, patch_weights};
+use super::bspline::{cubic_basis, patch_weights, position_weights};
 use super::patch::{
     CORNERS, LocalPatch, Ring, SampleStencil, child_frame, evaluate_face, evaluate_local, mat_mul,
     mat_vec, patch_grid, quadrant,
@@ -426,7 +426,7 @@ impl PatchTable {
     ) {
         let patch = &self.patches[f];
         if patch.regular {
-            let [w, ..] = patch_weights(st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0));
+            let w = position_weights(st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0));
             for (i, &wi) in w.iter().enumerate() {
                 if wi != 0.0 {
                     let (cols, ws) = self.grid_table.row(16 * f + i);
@@ -440,7 +440,7 @@ impl PatchTable {
         let tree = patch.tree.get_or_init(|| self.tree(f));
         let nc = tree.cols.len();
         if let Some((_, _, rows, x)) = tree.leaf_at(st) {
-            let [w, ..] = patch_weights(x[0], x[1]);
+            let w = position_weights(x[0], x[1]);
             for (k, &c) in tree.cols.iter().enumerate() {
                 visit(c, (0..16).map(|i| w[i] * rows[i * nc + k]).sum());
             }

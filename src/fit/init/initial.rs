@@ -5,7 +5,7 @@ use super::ellipsoid::{ellipsoid_axes, ellipsoid_cage};
 use super::frame::{MIN_POINTS, PrincipalFrame, check_points};
 use super::height_grid::height_grid;
 use super::occupancy::{OccupancyCage, occupancy_cage};
-use super::outliers::inlier_mask;
+use super::outliers::{Screening, screen};
 use super::params::{InitKind, InitParams, InitReport};
 use super::surface::surface_topology;
 use crate::error::{Error, Result};
@@ -54,7 +54,7 @@ pub fn initial_mesh(points: &PointCloud, params: &InitParams) -> Result<(PolyMes
     let original = points.len();
     check_points(&points.positions)?;
     let thinned = thinned(points);
-    let (cleaned, removed) = without_outliers(thinned.as_ref().unwrap_or(points));
+    let (cleaned, removed, screening) = without_outliers(thinned.as_ref().unwrap_or(points));
     let points = &cleaned;
     let frame = PrincipalFrame::from_points(&points.positions)?;
     let res = params.resolution;
@@ -99,6 +99,7 @@ pub fn initial_mesh(points: &PointCloud, params: &InitParams) -> Result<(PolyMes
     if removed > 0 {
         report.reason = format!("{removed} outliers dropped; {}", report.reason);
     }
+    report.screening = thinned.is_none().then_some(screening);
     if let Some(t) = &thinned {
         report.reason = format!(
             "thinned to {} of {} points; {}",
@@ -125,19 +126,21 @@ fn thinned(points: &PointCloud) -> Option<PointCloud> {
     })
 }
 
-/// The cloud without its outliers (and their normals), and how many were
-/// dropped; the whole cloud when fewer than [`MIN_POINTS`] would remain.
-fn without_outliers(points: &PointCloud) -> (PointCloud, usize) {
-    let keep = inlier_mask(&points.positions);
+/// The cloud without its outliers (and their normals), how many were
+/// dropped (the whole cloud when fewer than [`MIN_POINTS`] would remain)
+/// and the screening.
+fn without_outliers(points: &PointCloud) -> (PointCloud, usize, Screening) {
+    let screening = screen(&points.positions);
+    let keep = &screening.keep;
     let kept = keep.iter().filter(|&&k| k).count();
     if kept == points.len() || kept < MIN_POINTS {
-        return (points.clone(), 0);
+        return (points.clone(), 0, screening);
     }
     let cloud = PointCloud {
-        positions: kept_only(&points.positions, &keep),
-        normals: points.normals.as_ref().map(|n| kept_only(n, &keep)),
+        positions: kept_only(&points.positions, keep),
+        normals: points.normals.as_ref().map(|n| kept_only(n, keep)),
     };
-    (cloud, points.len() - kept)
+    (cloud, points.len() - kept, screening)
 }
 
 /// The items whose `keep` flag is set.
@@ -230,6 +233,7 @@ fn report(mesh: PolyMesh, chosen: InitKind, reason: String, genus: i64) -> (Poly
         genus: Some(genus),
         vertices: mesh.num_vertices(),
         faces: mesh.num_faces(),
+        screening: None,
     };
     (mesh, report)
 }

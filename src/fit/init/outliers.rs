@@ -65,10 +65,21 @@ const PASSES: usize = 2;
 /// fraction of the points (clean scans lose a handful and stop after one).
 const REPASS_FRACTION: Real = 0.005;
 
+/// A cloud's outlier screening ([`screen`]). The initial model and the fit
+/// screen the same cloud: [`super::initial_mesh`] reports its screening so
+/// that the fit ([`crate::fit::fit_screened_cloud`]) need not repeat it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Screening {
+    /// True for the points to keep.
+    pub keep: Vec<bool>,
+    /// The noise level of the first pass (0 when it cannot be told).
+    pub noise: Real,
+}
+
 /// True for the points to keep: up to two passes of the tests of the
 /// module docs, each on the points kept by the previous one.
 pub fn inlier_mask(points: &[Point3]) -> Vec<bool> {
-    inliers_and_noise(points).0
+    screen(points).keep
 }
 
 /// [`inlier_mask`] and the noise level of the first pass: the median over
@@ -76,7 +87,7 @@ pub fn inlier_mask(points: &[Point3]) -> Vec<bool> {
 /// least-squares plane, times [`UNTRIMMED_TO_NOISE`]; 0 when the cloud is too
 /// small or too degenerate to tell. Curvature within a neighbourhood adds
 /// to it, so on coarsely sampled curved surfaces it overestimates the noise.
-pub fn inliers_and_noise(points: &[Point3]) -> (Vec<bool>, Real) {
+pub fn screen(points: &[Point3]) -> Screening {
     let mut keep = vec![true; points.len()];
     let mut noise = None;
     for _ in 0..PASSES {
@@ -95,7 +106,10 @@ pub fn inliers_and_noise(points: &[Point3]) -> (Vec<bool>, Real) {
             break;
         }
     }
-    (keep, noise.unwrap_or(0.0))
+    Screening {
+        keep,
+        noise: noise.unwrap_or(0.0),
+    }
 }
 
 /// One pass of the tests and `σ̃`; clouds with at most `K + 1` points keep

@@ -149,4 +149,9 @@ pub struct InitReport {
     pub vertices: usize,
     /// Control faces (all quads).
     pub faces: usize,
+    /// The outlier screening of the cloud, for the fit to reuse
+    /// ([`crate::fit::fit_screened_cloud`]); `None` when the cloud was
+    /// thinned (the screening then covers the thinned points alone).
+    #[serde(skip)]
+    pub screening: Option<super::outliers::Screening>,
 }
