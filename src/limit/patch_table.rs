@@ -201,26 +201,54 @@ impl PatchTable {
         let fine = h.finest();
         let sharp = h.sharpness.last().expect("levels exist");
         let maps = param_maps(&h);
+        // A smooth corner is smooth in every face around its vertex (the
+        // kind then depends on the vertex alone): each vertex is classified
+        // once, and only the other corners face by face.
+        let smooth: Vec<bool> = (0..fine.num_vertices)
+            .into_par_iter()
+            .map(|v| {
+                fine.vertex_faces(v)
+                    .first()
+                    .is_some_and(|&f| corner_kind(fine, sharp, v, f) == CornerKind::Smooth)
+            })
+            .collect();
         let regular: Vec<bool> = (0..fine.num_faces())
             .into_par_iter()
             .map(|f| {
                 fine.face_vertices(f).iter().all(|&c| {
-                    corner_kind(fine, sharp, c as usize, f as u32) != CornerKind::Irregular
+                    smooth[c as usize]
+                        || corner_kind(fine, sharp, c as usize, f as u32) != CornerKind::Irregular
                 })
             })
             .collect();
-        let grids: Vec<Option<[RowBuilder; 16]>> = (0..fine.num_faces())
+        // Each face's 16 rows (empty at an irregular face): their ends,
+        // columns and weights, made in parallel and then laid end to end.
+        let grids: Vec<([usize; 16], Vec<u32>, Vec<Real>)> = (0..fine.num_faces())
             .into_par_iter()
-            .map(|f| regular[f].then(|| patch_grid(fine, sharp, f)))
-            .collect();
-        let mut grid_table = StencilTable::with_capacity(fine.num_vertices, 16 * grids.len(), 0);
-        for g in &grids {
-            for k in 0..16 {
-                match g {
-                    Some(rows) => grid_table.push_row(rows[k].entries()),
-                    None => grid_table.push_row(std::iter::empty()),
+            .map(|f| {
+                let (mut ends, mut cols, mut weights) = ([0; 16], Vec::new(), Vec::new());
+                if regular[f] {
+                    for (end, row) in ends.iter_mut().zip(patch_grid(fine, sharp, f)) {
+                        for (c, w) in row.entries() {
+                            cols.push(c);
+                            weights.push(w);
+                        }
+                        *end = cols.len();
+                    }
                 }
-            }
+                (ends, cols, weights)
+            })
+            .collect();
+        let mut grid_table = StencilTable::with_capacity(
+            fine.num_vertices,
+            16 * grids.len(),
+            grids.iter().map(|g| g.1.len()).sum(),
+        );
+        for (ends, cols, weights) in grids {
+            let first = grid_table.indices.len();
+            grid_table.offsets.extend(ends.map(|e| first + e));
+            grid_table.indices.extend(cols);
+            grid_table.weights.extend(weights);
         }
         let patches = maps
             .into_iter()
