@@ -237,7 +237,10 @@ impl PatchAssembly {
     /// of every patch `f` over level-`L` vertices of its one-ring (`cols`
     /// sorted, each `E_f` row-major), carried to the control points through
     /// the patch's rows `S_f` of `S` — the finite-element scatter and
-    /// `Sᵀ K_L S` in one pass.
+    /// `Sᵀ K_L S` in one pass. The patches of a block (a control face's
+    /// corners at level 1) are first summed over the union of their columns
+    /// (25 level-1 vertices for a regular face against 4 × 16), and the block
+    /// is carried once: about half the products of carrying each patch.
     pub fn values_of_elements<'a, const N: usize>(
         &self,
         table: &PatchTable,
@@ -245,58 +248,93 @@ impl PatchAssembly {
     ) -> Result<[Vec<Real>; N]> {
         let s = table.to_level();
         let patches = self.ring_offsets.len() - 1;
-        let chunk = patches.div_ceil(rayon::current_num_threads().max(1)).max(1);
-        let parts: Vec<[Vec<Real>; N]> = (0..patches)
-            .collect::<Vec<_>>()
+        // Runs of consecutive patches in one block.
+        let mut runs: Vec<(usize, usize)> = Vec::new();
+        for f in 0..patches {
+            match runs.last_mut() {
+                Some(run) if self.block[run.0] == self.block[f] => run.1 = f + 1,
+                _ => runs.push((f, f + 1)),
+            }
+        }
+        let chunk = runs
+            .len()
+            .div_ceil(rayon::current_num_threads().max(1))
+            .max(1);
+        let parts: Vec<[Vec<Real>; N]> = runs
             .par_chunks(chunk)
-            .map(|fs| {
+            .map(|runs| {
                 let mut values: [Vec<Real>; N] =
                     std::array::from_fn(|_| vec![0.0; self.indices.len()]);
-                // `c[k]`: the sum over the patches of `block` so far.
-                let mut c: [Vec<Real>; N] = std::array::from_fn(|_| Vec::new());
-                let (mut t, mut block) = (Vec::new(), None);
-                for &f in fs {
-                    let (cols, es) = element(f);
-                    let m = cols.len();
-                    if let Some(e) = es.iter().find(|e| e.len() != m * m) {
-                        return Err(Error::Input(format!(
-                            "patch {f}'s element has {} entries for {m} columns",
-                            e.len()
-                        )));
+                let (mut union, mut e, mut t, mut c) = (
+                    Vec::new(),
+                    std::array::from_fn::<_, N, _>(|_| Vec::new()),
+                    Vec::new(),
+                    Vec::new(),
+                );
+                for &(lo, hi) in runs {
+                    // The union of the run's columns, sorted.
+                    union.clear();
+                    for f in lo..hi {
+                        union.extend_from_slice(element(f).0);
                     }
-                    let first = self.ring_offsets[f];
-                    let ring = &self.ring[first..self.ring_offsets[f + 1]];
-                    // Each column's row of S: its weights and support positions.
-                    let rows = cols
-                        .iter()
-                        .map(|&col| {
+                    union.sort_unstable();
+                    union.dedup();
+                    let m = union.len();
+                    // `e[k]`: the run's elements summed over the union.
+                    for e in &mut e {
+                        e.clear();
+                        e.resize(m * m, 0.0);
+                    }
+                    for f in lo..hi {
+                        let (cols, es) = element(f);
+                        let k = cols.len();
+                        if let Some(x) = es.iter().find(|x| x.len() != k * k) {
+                            return Err(Error::Input(format!(
+                                "patch {f}'s element has {} entries for {k} columns",
+                                x.len()
+                            )));
+                        }
+                        // Present: the union holds every column of the run.
+                        let at: Vec<usize> = cols
+                            .iter()
+                            .map(|c| union.binary_search(c).unwrap_or(0))
+                            .collect();
+                        for (sum, x) in e.iter_mut().zip(es) {
+                            for (i, &ai) in at.iter().enumerate() {
+                                let row = &mut sum[ai * m..(ai + 1) * m];
+                                for (&aj, &y) in at.iter().zip(&x[i * k..(i + 1) * k]) {
+                                    row[aj] += y;
+                                }
+                            }
+                        }
+                    }
+                    // Each union column's row of S: its weights and places
+                    // in the support (which the run's patches share),
+                    // through the one-ring of a patch that has the column.
+                    let mut rows: Vec<(&[Real], &[u16])> = vec![(&[], &[]); m];
+                    for f in lo..hi {
+                        let first = self.ring_offsets[f];
+                        let ring = &self.ring[first..self.ring_offsets[f + 1]];
+                        for &col in element(f).0 {
+                            let i = union.binary_search(&col).unwrap_or(0);
+                            if !rows[i].0.is_empty() {
+                                continue;
+                            }
                             let j = ring.binary_search(&col).map_err(|_| {
                                 Error::Topology(format!(
                                     "level vertex {col} is outside patch {f}'s one-ring"
                                 ))
                             })?;
-                            Ok((
+                            rows[i] = (
                                 s.row(col as usize).1,
                                 &self.ring_positions[self.ring_map[first + j]..],
-                            ))
-                        })
-                        .collect::<Result<Vec<_>>>()?;
-                    let b = self.block[f] as usize;
-                    let n = self.support_of_block(b).len();
-                    if block != Some(b) {
-                        if let Some(done) = block {
-                            for (c, v) in c.iter().zip(&mut values) {
-                                self.scatter(done, c, v);
-                            }
-                        }
-                        block = Some(b);
-                        for c in &mut c {
-                            c.clear();
-                            c.resize(n * n, 0.0);
+                            );
                         }
                     }
-                    for (e, c) in es.iter().zip(&mut c) {
-                        // T = E S_f (m × n), then C += S_fᵀ T (n × n).
+                    let b = self.block[lo] as usize;
+                    let n = self.support_of_block(b).len();
+                    for (e, values) in e.iter().zip(&mut values) {
+                        // T = E S (m × n), then C = Sᵀ T (n × n).
                         t.clear();
                         t.resize(m * n, 0.0);
                         for (j, (w, at)) in rows.iter().enumerate() {
@@ -306,6 +344,8 @@ impl PatchAssembly {
                                 }
                             }
                         }
+                        c.clear();
+                        c.resize(n * n, 0.0);
                         for (i, (w, at)) in rows.iter().enumerate() {
                             for (&x, &a) in w.iter().zip(*at) {
                                 let a = a as usize;
@@ -316,11 +356,7 @@ impl PatchAssembly {
                                 }
                             }
                         }
-                    }
-                }
-                if let Some(done) = block {
-                    for (c, v) in c.iter().zip(&mut values) {
-                        self.scatter(done, c, v);
+                        self.scatter(b, &c, values);
                     }
                 }
                 Ok(values)
