@@ -240,7 +240,7 @@ impl PatchAssembly {
     /// `Sᵀ K_L S` in one pass. The patches of a block (a control face's
     /// corners at level 1) are first summed over the union of their columns
     /// (25 level-1 vertices for a regular face against 4 × 16), and the block
-    /// is carried once: about half the products of carrying each patch.
+    /// is carried once, in fewer products than carrying each patch.
     pub fn values_of_elements<'a, const N: usize>(
         &self,
         table: &PatchTable,
