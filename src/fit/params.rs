@@ -91,7 +91,7 @@ pub struct FitParams {
     /// its nearest data point, Huber-weighted) relative to the data-to-surface
     /// springs (default 0.5; 0 turns them off).
     pub surface_weight: Real,
-    /// Leave the points that [`crate::fit::init::outliers::inlier_mask`]
+    /// Leave the points that [`crate::fit::init::outliers::screen`]
     /// flags (far off the plane of their neighbours, or isolated) out of
     /// both kinds of springs (default true). The robust weights alone let a
     /// lone outlier near the surface pull a spike: it is admitted while the

@@ -265,7 +265,8 @@ impl PatchAssembly {
             .map(|runs| {
                 let mut values: [Vec<Real>; N] =
                     std::array::from_fn(|_| vec![0.0; self.indices.len()]);
-                let (mut union, mut e, mut t, mut c) = (
+                let (mut union, mut at, mut e, mut t, mut c) = (
+                    Vec::new(),
                     Vec::new(),
                     std::array::from_fn::<_, N, _>(|_| Vec::new()),
                     Vec::new(),
@@ -295,10 +296,8 @@ impl PatchAssembly {
                             )));
                         }
                         // Present: the union holds every column of the run.
-                        let at: Vec<usize> = cols
-                            .iter()
-                            .map(|c| union.binary_search(c).unwrap_or(0))
-                            .collect();
+                        at.clear();
+                        at.extend(cols.iter().map(|c| union.binary_search(c).unwrap_or(0)));
                         for (sum, x) in e.iter_mut().zip(es) {
                             for (i, &ai) in at.iter().enumerate() {
                                 let row = &mut sum[ai * m..(ai + 1) * m];

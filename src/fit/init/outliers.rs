@@ -76,17 +76,13 @@ pub struct Screening {
     pub noise: Real,
 }
 
-/// True for the points to keep: up to two passes of the tests of the
-/// module docs, each on the points kept by the previous one.
-pub fn inlier_mask(points: &[Point3]) -> Vec<bool> {
-    screen(points).keep
-}
-
-/// [`inlier_mask`] and the noise level of the first pass: the median over
-/// the cloud of the 8 neighbours' RMS offset `r` from their (untrimmed)
-/// least-squares plane, times [`UNTRIMMED_TO_NOISE`]; 0 when the cloud is too
-/// small or too degenerate to tell. Curvature within a neighbourhood adds
-/// to it, so on coarsely sampled curved surfaces it overestimates the noise.
+/// The points to keep (up to two passes of the tests of the module docs,
+/// each on the points kept by the previous one) and the noise level of the
+/// first pass: the median over the cloud of the 8 neighbours' RMS offset `r`
+/// from their (untrimmed) least-squares plane, times [`UNTRIMMED_TO_NOISE`];
+/// 0 when the cloud is too small or too degenerate to tell. Curvature within
+/// a neighbourhood adds to it, so on coarsely sampled curved surfaces it
+/// overestimates the noise.
 pub fn screen(points: &[Point3]) -> Screening {
     let mut keep = vec![true; points.len()];
     let mut noise = None;
