@@ -584,7 +584,9 @@ fn patch_assembly_equals_the_sparse_spring_products() {
             .map(|i| if i % 7 == 0 { 0.0 } else { lcg(&mut seed) })
             .collect();
         let reference = spring_system(&engine, &points, &closest, &k).unwrap();
-        let fast = assembly.data_springs(table, &points, &closest, &k).unwrap();
+        let fast = assembly
+            .data_springs(table, &points, &closest, &k, None)
+            .unwrap();
         let (worst, m) = table_difference(&reference.matrix, &fast.matrix);
         assert!(m > 0.0 && worst <= 1e-12 * m, "matrix {worst:e} of {m:e}");
         for (a, b) in reference.rhs.iter().zip(&fast.rhs) {
@@ -610,7 +612,12 @@ fn patch_assembly_equals_the_sparse_spring_products() {
             .collect();
         let kr: Vec<Real> = (0..at.len()).map(|_| lcg(&mut seed)).collect();
         let reference = row_springs(&rows, &x, &d, &kr).unwrap();
-        let on_patches = assembly.rows_on_patches(rows.clone(), |i| at[i].0).unwrap();
+        let on_patches = assembly.rows_at(table, &at).unwrap();
+        let (worst, m) = table_difference(&rows, on_patches.rows());
+        assert!(
+            m > 0.0 && worst <= 1e-12 * m,
+            "rows on patches {worst:e} of {m:e}"
+        );
         let fast = assembly.row_springs(&on_patches, &x, &d, &kr).unwrap();
         let (worst, m) = table_difference(&reference.matrix, &fast.matrix);
         assert!(
@@ -644,15 +651,10 @@ fn patch_assembly_equals_the_sparse_spring_products() {
     let full = StencilTable::from_rows(n, &vec![(0..n as u32).map(|c| (c, 1.0)).collect(); n]);
     assert!(assembly.values_of(&full).is_err());
     assert!(assembly.num_entries() < n * n);
-    // A row of the first patch, claimed to be on the last, leaves its support.
-    let (c, w) = table.position_stencil(0, [0.5, 0.5]);
-    let mut row = StencilTable::with_capacity(table.to_level().num_rows(), 1, 0);
-    row.push_row(c.into_iter().zip(w));
-    let row = row.compose(table.to_level()).unwrap();
-    let x = row.apply(&grid.positions).unwrap();
+    // A row on a patch out of range is refused.
     let last = table.num_patches() - 1;
-    let on_first = assembly.rows_on_patches(row.clone(), |_| 0).unwrap();
-    assert!(assembly.row_springs(&on_first, &x, &x, &[1.0]).is_ok());
-    assert!(assembly.rows_on_patches(row.clone(), |_| last).is_err());
-    assert!(assembly.rows_on_patches(row, |_| last + 1).is_err());
+    let on_last = assembly.rows_at(&table, &[(last, [0.5, 0.5])]).unwrap();
+    let x = on_last.rows().apply(&grid.positions).unwrap();
+    assert!(assembly.row_springs(&on_last, &x, &x, &[1.0]).is_ok());
+    assert!(assembly.rows_at(&table, &[(last + 1, [0.5, 0.5])]).is_err());
 }

@@ -41,7 +41,7 @@ use crate::error::{Error, Result};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
-use crate::forces::{PatchAssembly, RobustKernel, robust_weights};
+use crate::forces::{PatchAssembly, RobustKernel, RowSprings, robust_weights};
 use crate::limit::{
     ClosestPointEngine, ClosestPointParams, QuadtreeCache, interpolate_limit_points, limit_stencil,
 };
@@ -182,7 +182,6 @@ pub fn fit_screened_cloud(
         // The thin plate and the damping, patch by patch on the engine's
         // pieces: exact on regular faces (one bicubic each).
         let table = engine.table();
-        let s = table.to_level();
         let area = parameter_area(table);
         let material = MaterialParams::thin_plate(params.tension, params.bending, area);
         let assembly = PatchAssembly::new(table)?;
@@ -211,11 +210,7 @@ pub fn fit_screened_cloud(
         } else {
             None
         };
-        let per_patch = params.surface_samples * params.surface_samples;
-        let centres = assembly.rows_on_patches(
-            surface_samples(table, params.surface_samples).compose(s)?,
-            |i| i / per_patch,
-        )?;
+        let centres = assembly.rows_at(table, &surface_samples(table, params.surface_samples))?;
         let setup_seconds = level_start.elapsed().as_secs_f64();
         let mut p = mesh.positions.clone();
         // The previous step's positions (at rest when a level starts).
@@ -326,10 +321,18 @@ pub fn fit_screened_cloud(
             if settled || steps >= params.max_steps {
                 break (dist, hints);
             }
-            let mut springs = assembly.data_springs(engine.table(), used, &closest, &kw)?;
-            if let Some((xs, targets, ks, _)) = &surface {
-                springs.add(&assembly.row_springs(&centres, xs, targets, ks)?)?;
-            }
+            let springs = assembly.data_springs(
+                engine.table(),
+                used,
+                &closest,
+                &kw,
+                surface.as_ref().map(|(x, d, k, _)| RowSprings {
+                    rows: &centres,
+                    x,
+                    d,
+                    k,
+                }),
+            )?;
             let mut a = springs.matrix;
             for (x, y) in a.weights.iter_mut().zip(&kd_values) {
                 *x += y;

@@ -4,7 +4,6 @@
 
 use crate::limit::PatchTable;
 use crate::math::Real;
-use crate::stencil::StencilTable;
 
 /// `0..n` in a fixed pseudo-random order (a multiplicative hash of the
 /// index), so that every prefix is an even subsample of a cloud.
@@ -23,19 +22,13 @@ pub(super) fn shuffled_order(n: usize) -> Vec<usize> {
     order.into_iter().map(|(_, i)| i).collect()
 }
 
-/// `per_side × per_side` cell centres of every patch of `table` (rows over
-/// its level-`L` vertices): where the surface-to-data springs attach.
-pub(super) fn surface_samples(table: &PatchTable, per_side: usize) -> StencilTable {
-    let per_patch = per_side * per_side;
-    StencilTable::from_row_fn(
-        per_patch * table.num_patches(),
-        table.to_level().num_rows(),
-        |r, b| {
-            let i = r % per_patch;
-            let st = [i % per_side, i / per_side].map(|k| (k as Real + 0.5) / per_side as Real);
-            table.visit_position_weights(r / per_patch, st, |c, w| b.add(c, w));
-        },
-    )
+/// `per_side × per_side` cell centres of every patch of `table`, as
+/// (patch, `(s, t)`): where the surface-to-data springs attach.
+pub(super) fn surface_samples(table: &PatchTable, per_side: usize) -> Vec<(usize, [Real; 2])> {
+    let cell = |k: usize| (k as Real + 0.5) / per_side as Real;
+    (0..table.num_patches())
+        .flat_map(|f| (0..per_side * per_side).map(move |i| (f, [cell(i % per_side), cell(i / per_side)])))
+        .collect()
 }
 
 /// Root mean square of the smallest `fraction` of `d`.

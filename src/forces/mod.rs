@@ -11,6 +11,6 @@ mod springs;
 
 pub use image::{BoundaryModel, ImageField, Offset};
 pub use inflation::inflation_force;
-pub use patch_assembly::{PatchAssembly, PatchRows};
+pub use patch_assembly::{PatchAssembly, PatchRows, RowSprings};
 pub use robust::{RobustKernel, robust_weights};
 pub use springs::{SpringSystem, drag_spring, row_springs, spread_point_springs, spring_system};

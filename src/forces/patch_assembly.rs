@@ -383,78 +383,122 @@ impl PatchAssembly {
 
     /// Springs from `points[i]` to their closest points `closest[i]` with
     /// stiffness `k[i]`: the same system as
-    /// [`spring_system`](super::spring_system), its matrix in the pattern.
+    /// [`spring_system`](super::spring_system), its matrix in the pattern;
+    /// with `and`, plus those springs ([`row_springs`](Self::row_springs)),
+    /// summed in the same pass (a block's springs of both kinds share one
+    /// dense sum and one scatter).
     pub fn data_springs(
         &self,
         table: &PatchTable,
         points: &[Point3],
         closest: &[ClosestPoint],
         k: &[Real],
+        and: Option<RowSprings>,
     ) -> Result<SpringSystem> {
         check_lengths(points.len(), closest.len(), k.len())?;
-        let s = table.to_level();
+        let n = points.len();
+        let extra = match and {
+            Some(r) => r.check()?,
+            None => 0,
+        };
         self.springs(
-            points.len(),
-            |i| closest[i].patch.0 as usize,
-            |i, f, u| {
-                let st = closest[i].patch.1;
-                let first = self.ring_offsets[f];
-                let ring = &self.ring[first..self.ring_offsets[f + 1]];
-                let mut outside = None;
-                table.visit_position_weights(f, st, |c, wc| match ring.binary_search(&c) {
-                    Ok(j) => {
-                        let at = &self.ring_positions[self.ring_map[first + j]..];
-                        for (&x, &a) in s.row(c as usize).1.iter().zip(at) {
-                            u[a as usize] += wc * x;
-                        }
-                    }
-                    Err(_) => outside = Some(c),
-                });
-                if let Some(c) = outside {
-                    return Err(Error::Topology(format!(
-                        "level vertex {c} is outside patch {f}'s one-ring"
-                    )));
+            n + extra,
+            |i| match and {
+                Some(r) if i >= n => r.rows.patch[i - n] as usize,
+                _ => closest[i].patch.0 as usize,
+            },
+            |i, f, u| match and {
+                Some(r) if i >= n => Ok(r.spring(i - n, u)),
+                _ => {
+                    self.add_position_row(table, f, closest[i].patch.1, u)?;
+                    Ok((closest[i].point, points[i], k[i]))
                 }
-                Ok((closest[i].point, points[i], k[i]))
             },
         )
     }
 
-    /// `rows` (over the control points), row `i` a point on patch
-    /// `patch_of(i)`, with every entry's place in that patch's support
-    /// looked up once: for springs that stay on their patches step after
-    /// step ([`row_springs`](Self::row_springs)). Errors when a row leaves
-    /// its patch's support or names a patch out of range.
-    pub fn rows_on_patches(
+    /// Adds the row over the control points of the limit point at `st` of
+    /// patch `f` to `u` (zeroed, over `f`'s support): the patch's weights
+    /// over its level-`L` one-ring carried through their rows of `S`.
+    fn add_position_row(
         &self,
-        rows: StencilTable,
-        patch_of: impl Fn(usize) -> usize + Sync,
-    ) -> Result<PatchRows> {
+        table: &PatchTable,
+        f: usize,
+        st: [Real; 2],
+        u: &mut [Real],
+    ) -> Result<()> {
+        let s = table.to_level();
+        let first = self.ring_offsets[f];
+        let ring = &self.ring[first..self.ring_offsets[f + 1]];
+        let mut outside = None;
+        table.visit_position_weights(f, st, |c, wc| match ring.binary_search(&c) {
+            Ok(j) => {
+                let at = &self.ring_positions[self.ring_map[first + j]..];
+                for (&x, &a) in s.row(c as usize).1.iter().zip(at) {
+                    u[a as usize] += wc * x;
+                }
+            }
+            Err(_) => outside = Some(c),
+        });
+        match outside {
+            Some(c) => Err(Error::Topology(format!(
+                "level vertex {c} is outside patch {f}'s one-ring"
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// The rows over the control points of the limit points `at[i] = (f,
+    /// st)` (patch `f` of `table`, its `(s, t)`), each entry's place in its
+    /// patch's support kept: for springs that stay on their patches step
+    /// after step ([`row_springs`](Self::row_springs)). Errors when a patch
+    /// is out of range.
+    pub fn rows_at(&self, table: &PatchTable, at: &[(usize, [Real; 2])]) -> Result<PatchRows> {
         let patches = self.block.len();
-        let per_row: Vec<(u32, Vec<u16>)> = (0..rows.num_rows())
-            .into_par_iter()
-            .map(|i| {
-                let f = patch_of(i);
+        if table.num_patches() != patches {
+            return Err(Error::Input(format!(
+                "a table of {} patches for an assembly of {patches}",
+                table.num_patches()
+            )));
+        }
+        let per_row: Vec<Vec<(u16, Real)>> = at
+            .par_iter()
+            .enumerate()
+            .map_init(Vec::new, |u, (i, &(f, st))| {
                 if f >= patches {
                     return Err(Error::Input(format!(
                         "row {i} is on patch {f} of {patches}"
                     )));
                 }
-                let sup = self.support_of_block(self.block[f] as usize);
-                let at = rows
-                    .row(i)
-                    .0
-                    .iter()
-                    .map(|&c| position(sup, c).map(|p| p as u16))
-                    .collect::<Result<_>>()?;
-                Ok((f as u32, at))
+                u.clear();
+                u.resize(self.support_of_block(self.block[f] as usize).len(), 0.0);
+                self.add_position_row(table, f, st, u)?;
+                Ok(u.iter()
+                    .enumerate()
+                    .filter(|e| *e.1 != 0.0)
+                    .map(|(a, &w)| (a as u16, w))
+                    .collect())
             })
             .collect::<Result<_>>()?;
-        let (patch, at): (Vec<u32>, Vec<Vec<u16>>) = per_row.into_iter().unzip();
+        let mut rows = StencilTable {
+            num_cols: self.offsets.len() - 1,
+            offsets: offsets_of(per_row.iter().map(Vec::len)),
+            indices: Vec::new(),
+            weights: Vec::new(),
+        };
+        let mut places = Vec::with_capacity(rows.num_entries());
+        for (entries, &(f, _)) in per_row.iter().zip(at) {
+            let sup = self.support_of_block(self.block[f] as usize);
+            for &(a, w) in entries {
+                rows.indices.push(sup[a as usize]);
+                rows.weights.push(w);
+                places.push(a);
+            }
+        }
         Ok(PatchRows {
             rows,
-            patch,
-            at: at.concat(),
+            patch: at.iter().map(|a| a.0 as u32).collect(),
+            at: places,
         })
     }
 
@@ -468,19 +512,11 @@ impl PatchAssembly {
         d: &[Point3],
         k: &[Real],
     ) -> Result<SpringSystem> {
-        let r = &rows.rows;
-        check_lengths(r.num_rows(), x.len(), d.len())?;
-        check_lengths(r.num_rows(), k.len(), d.len())?;
+        let r = RowSprings { rows, x, d, k };
         self.springs(
-            d.len(),
+            r.check()?,
             |i| rows.patch[i] as usize,
-            |i, _, u| {
-                let (lo, hi) = (r.offsets[i], r.offsets[i + 1]);
-                for (&a, &w) in rows.at[lo..hi].iter().zip(&r.weights[lo..hi]) {
-                    u[a as usize] += w;
-                }
-                Ok((x[i], d[i], k[i]))
-            },
+            |i, _, u| Ok(r.spring(i, u)),
         )
     }
 
@@ -588,7 +624,7 @@ impl PatchAssembly {
 }
 
 /// Rows over the control points on known patches of a [`PatchAssembly`]
-/// ([`PatchAssembly::rows_on_patches`]).
+/// ([`PatchAssembly::rows_at`]).
 #[derive(Clone, Debug)]
 pub struct PatchRows {
     rows: StencilTable,
@@ -605,13 +641,39 @@ impl PatchRows {
     }
 }
 
-/// Where control point `c` sits in the sorted `support`.
-fn position(support: &[u32], c: u32) -> Result<usize> {
-    support.binary_search(&c).map_err(|_| {
-        Error::Topology(format!(
-            "control point {c} is outside its patch's one-ring support"
-        ))
-    })
+/// Springs from surface points `x[i] = rows[i] · p` to targets `d[i]` with
+/// stiffness `k[i]` ([`PatchAssembly::row_springs`]).
+#[derive(Clone, Copy, Debug)]
+pub struct RowSprings<'a> {
+    /// Where the springs attach.
+    pub rows: &'a PatchRows,
+    /// The attachments' current positions.
+    pub x: &'a [Point3],
+    /// The targets.
+    pub d: &'a [Point3],
+    /// The stiffnesses.
+    pub k: &'a [Real],
+}
+
+impl RowSprings<'_> {
+    /// The number of springs, or an error when the lengths differ.
+    fn check(&self) -> Result<usize> {
+        let n = self.rows.rows.num_rows();
+        check_lengths(n, self.x.len(), self.d.len())?;
+        check_lengths(n, self.k.len(), self.d.len())?;
+        Ok(n)
+    }
+
+    /// Writes spring `i`'s row over its patch's support into `u`; its `x`,
+    /// `d` and `k`.
+    fn spring(&self, i: usize, u: &mut [Real]) -> (Point3, Point3, Real) {
+        let r = &self.rows.rows;
+        let (lo, hi) = (r.offsets[i], r.offsets[i + 1]);
+        for (&a, &w) in self.rows.at[lo..hi].iter().zip(&r.weights[lo..hi]) {
+            u[a as usize] += w;
+        }
+        (self.x[i], self.d[i], self.k[i])
+    }
 }
 
 /// The entrywise sum of `parts` (zeros of length `len` if there are none).
