@@ -473,11 +473,14 @@ impl PatchAssembly {
                 u.clear();
                 u.resize(self.support_of_block(self.block[f] as usize).len(), 0.0);
                 self.add_position_row(table, f, st, u)?;
-                Ok(u.iter()
-                    .enumerate()
-                    .filter(|e| *e.1 != 0.0)
-                    .map(|(a, &w)| (a as u16, w))
-                    .collect())
+                let mut row = Vec::with_capacity(u.iter().filter(|&&w| w != 0.0).count());
+                row.extend(
+                    u.iter()
+                        .enumerate()
+                        .filter(|e| *e.1 != 0.0)
+                        .map(|(a, &w)| (a as u16, w)),
+                );
+                Ok(row)
             })
             .collect::<Result<_>>()?;
         let mut rows = StencilTable {
