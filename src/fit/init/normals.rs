@@ -54,16 +54,13 @@ pub fn oriented_normals(points: &[Point3], tree: &ImmutableKdTree<Real, 3>) -> V
         .par_iter()
         .map(|nb| plane_normal(points, nb))
         .collect();
-    // Symmetric k-nearest-neighbour graph.
-    let mut graph: Vec<Vec<u32>> = neighbours.clone();
-    for (i, nb) in neighbours.iter().enumerate() {
-        for &j in nb {
-            if j as usize != i && !neighbours[j as usize].contains(&(i as u32)) {
-                graph[j as usize].push(i as u32);
-            }
-        }
-    }
+    let graph = symmetric_graph(&neighbours);
     let mut reached = vec![false; points.len()];
+    // The cheapest known edge into each point not yet reached and its other
+    // end: an edge no cheaper (or, at equal cost, from a lower parent, which
+    // the heap would pop later) is not pushed, as it could only be popped
+    // after the point is reached.
+    let mut best: Vec<(Real, u32)> = vec![(Real::INFINITY, 0); points.len()];
     let centroid =
         points.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / points.len().max(1) as Real;
     let away = |i: usize| points[i].coords - centroid;
@@ -87,11 +84,18 @@ pub fn oriented_normals(points: &[Point3], tree: &ImmutableKdTree<Real, 3>) -> V
             if normals[i].dot(&normals[parent as usize]) < 0.0 {
                 normals[i] = -normals[i];
             }
-            for &j in &graph[i] {
-                if !reached[j as usize] {
-                    let cost = 1.0 - normals[i].dot(&normals[j as usize]).abs();
-                    heap.push((Reverse(Cost(cost)), j, i as u32));
+            for &j in graph.neighbours(i) {
+                let j = j as usize;
+                if reached[j] {
+                    continue;
                 }
+                let cost = 1.0 - normals[i].dot(&normals[j]).abs();
+                let (known, from) = best[j];
+                if cost > known || (cost == known && (i as u32) < from) {
+                    continue;
+                }
+                best[j] = (cost, i as u32);
+                heap.push((Reverse(Cost(cost)), j as u32, i as u32));
             }
         }
     }
@@ -122,6 +126,48 @@ fn plane_normal(points: &[Point3], nb: &[u32]) -> Vector3 {
         .unwrap_or((0, &0.0));
     let n = eig.eigenvectors.column(smallest).into_owned();
     n.try_normalize(0.0).unwrap_or_else(Vector3::zeros)
+}
+
+/// A graph in compressed rows: the neighbours of `i` are
+/// `targets[offsets[i]..offsets[i + 1]]`.
+struct Graph {
+    offsets: Vec<usize>,
+    targets: Vec<u32>,
+}
+
+impl Graph {
+    fn neighbours(&self, i: usize) -> &[u32] {
+        &self.targets[self.offsets[i]..self.offsets[i + 1]]
+    }
+}
+
+/// The symmetric `k`-nearest-neighbour graph: `j` next to `i` when either
+/// is among the other's nearest (`neighbours[i]` first, in its order, then
+/// the points that have `i` among theirs and are not among `i`'s).
+fn symmetric_graph(neighbours: &[Vec<u32>]) -> Graph {
+    let n = neighbours.len();
+    // The extra (reverse) edges, grouped by their source in order of `i`.
+    let mut extra: Vec<(u32, u32)> = Vec::new();
+    for (i, nb) in neighbours.iter().enumerate() {
+        for &j in nb {
+            if j as usize != i && !neighbours[j as usize].contains(&(i as u32)) {
+                extra.push((j, i as u32));
+            }
+        }
+    }
+    extra.sort_by_key(|e| e.0);
+    let mut offsets = Vec::with_capacity(n + 1);
+    offsets.push(0);
+    let mut targets = Vec::with_capacity(neighbours.iter().map(Vec::len).sum::<usize>() + extra.len());
+    let mut rest = extra.iter().peekable();
+    for (i, nb) in neighbours.iter().enumerate() {
+        targets.extend_from_slice(nb);
+        while let Some(&(_, j)) = rest.next_if(|e| e.0 as usize == i) {
+            targets.push(j);
+        }
+        offsets.push(targets.len());
+    }
+    Graph { offsets, targets }
 }
 
 /// A total order on costs for the propagation heap (costs are finite).
