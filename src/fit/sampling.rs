@@ -27,7 +27,9 @@ pub(super) fn shuffled_order(n: usize) -> Vec<usize> {
 pub(super) fn surface_samples(table: &PatchTable, per_side: usize) -> Vec<(usize, [Real; 2])> {
     let cell = |k: usize| (k as Real + 0.5) / per_side as Real;
     (0..table.num_patches())
-        .flat_map(|f| (0..per_side * per_side).map(move |i| (f, [cell(i % per_side), cell(i / per_side)])))
+        .flat_map(|f| {
+            (0..per_side * per_side).map(move |i| (f, [cell(i % per_side), cell(i / per_side)]))
+        })
         .collect()
 }
 

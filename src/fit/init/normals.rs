@@ -158,7 +158,8 @@ fn symmetric_graph(neighbours: &[Vec<u32>]) -> Graph {
     extra.sort_by_key(|e| e.0);
     let mut offsets = Vec::with_capacity(n + 1);
     offsets.push(0);
-    let mut targets = Vec::with_capacity(neighbours.iter().map(Vec::len).sum::<usize>() + extra.len());
+    let mut targets =
+        Vec::with_capacity(neighbours.iter().map(Vec::len).sum::<usize>() + extra.len());
     let mut rest = extra.iter().peekable();
     for (i, nb) in neighbours.iter().enumerate() {
         targets.extend_from_slice(nb);
