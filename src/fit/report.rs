@@ -35,12 +35,16 @@ impl ErrorStats {
         }
         let n = d.len() as Real;
         let mut sorted = d.to_vec();
-        sorted.sort_by(|a, b| a.total_cmp(b));
         let rank = ((0.95 * n).ceil() as usize).clamp(1, d.len()) - 1;
-        let max = sorted[d.len() - 1];
+        // The element of that rank in sorted order, and those above it.
+        let (_, &mut p95, above) = sorted.select_nth_unstable_by(rank, |a, b| a.total_cmp(b));
+        let max = above
+            .iter()
+            .copied()
+            .max_by(|a, b| a.total_cmp(b))
+            .unwrap_or(p95);
         let mean = d.iter().sum::<Real>() / n;
         let rms = (d.iter().map(|x| x * x).sum::<Real>() / n).sqrt();
-        let p95 = sorted[rank];
         let pct = |x: Real| 100.0 * x / diameter;
         ErrorStats {
             max,

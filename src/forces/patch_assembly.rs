@@ -28,6 +28,9 @@ use crate::stencil::StencilTable;
 
 use super::SpringSystem;
 
+/// Rows of [`PatchAssembly::rows_at`] made by one task.
+const ROWS_PER_CHUNK: usize = 2048;
+
 /// The sparsity pattern of the control-point system of a [`PatchTable`] and
 /// each patch's support and slots in it.
 #[derive(Clone, Debug)]
@@ -461,43 +464,51 @@ impl PatchAssembly {
                 table.num_patches()
             )));
         }
-        let per_row: Vec<Vec<(u16, Real)>> = at
-            .par_iter()
+        // Chunks of rows made in parallel, each as its rows' lengths and
+        // entries (control point, weight, place in the support).
+        type Chunk = (Vec<usize>, Vec<u32>, Vec<Real>, Vec<u16>);
+        let chunks: Vec<Chunk> = at
+            .par_chunks(ROWS_PER_CHUNK)
             .enumerate()
-            .map_init(Vec::new, |u, (i, &(f, st))| {
-                if f >= patches {
-                    return Err(Error::Input(format!(
-                        "row {i} is on patch {f} of {patches}"
-                    )));
+            .map(|(c, chunk)| {
+                let (mut u, mut out) = (Vec::new(), Chunk::default());
+                for (i, &(f, st)) in chunk.iter().enumerate() {
+                    if f >= patches {
+                        return Err(Error::Input(format!(
+                            "row {} is on patch {f} of {patches}",
+                            c * ROWS_PER_CHUNK + i
+                        )));
+                    }
+                    let sup = self.support_of_block(self.block[f] as usize);
+                    u.clear();
+                    u.resize(sup.len(), 0.0);
+                    self.add_position_row(table, f, st, &mut u)?;
+                    let before = out.1.len();
+                    for (a, &w) in u.iter().enumerate().filter(|e| *e.1 != 0.0) {
+                        out.1.push(sup[a]);
+                        out.2.push(w);
+                        out.3.push(a as u16);
+                    }
+                    out.0.push(out.1.len() - before);
                 }
-                u.clear();
-                u.resize(self.support_of_block(self.block[f] as usize).len(), 0.0);
-                self.add_position_row(table, f, st, u)?;
-                let mut row = Vec::with_capacity(u.iter().filter(|&&w| w != 0.0).count());
-                row.extend(
-                    u.iter()
-                        .enumerate()
-                        .filter(|e| *e.1 != 0.0)
-                        .map(|(a, &w)| (a as u16, w)),
-                );
-                Ok(row)
+                Ok(out)
             })
             .collect::<Result<_>>()?;
-        let mut rows = StencilTable {
-            num_cols: self.offsets.len() - 1,
-            offsets: offsets_of(per_row.iter().map(Vec::len)),
-            indices: Vec::new(),
-            weights: Vec::new(),
-        };
-        let mut places = Vec::with_capacity(rows.num_entries());
-        for (entries, &(f, _)) in per_row.iter().zip(at) {
-            let sup = self.support_of_block(self.block[f] as usize);
-            for &(a, w) in entries {
-                rows.indices.push(sup[a as usize]);
-                rows.weights.push(w);
-                places.push(a);
-            }
+        let (mut lengths, mut indices, mut weights, mut places) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for (l, i, w, p) in chunks {
+            lengths.push(l);
+            indices.push(i);
+            weights.push(w);
+            places.push(p);
         }
+        let rows = StencilTable {
+            num_cols: self.offsets.len() - 1,
+            offsets: offsets_of(lengths.concat().into_iter()),
+            indices: indices.concat(),
+            weights: weights.concat(),
+        };
+        let places = places.concat();
         Ok(PatchRows {
             rows,
             patch: at.iter().map(|a| a.0 as u32).collect(),
@@ -559,7 +570,7 @@ impl PatchAssembly {
             }
             order.push((self.block[f], i));
         }
-        order.sort_unstable();
+        order.par_sort_unstable();
         let chunk = count.div_ceil(rayon::current_num_threads().max(1)).max(1);
         let parts: Vec<(Vec<Real>, Vec<Point3>, Real)> = order
             .par_chunks(chunk)

@@ -308,16 +308,17 @@ impl ClosestPointEngine {
         // the same control points and quadtree, which then stay in cache
         // (the callers' points come in any order, often shuffled).
         let mut order: Vec<u32> = (0..queries.len() as u32).collect();
-        order.sort_unstable_by_key(|&i| starts[i as usize].0);
+        order.par_sort_unstable_by_key(|&i| starts[i as usize].0);
         let found: Vec<ClosestPoint> = order
             .par_iter()
             .map(|&i| query(queries[i as usize], starts[i as usize]))
             .collect::<Result<_>>()?;
-        let mut out = found.clone();
-        for (&i, c) in order.iter().zip(found) {
-            out[i as usize] = c;
+        // Back in the queries' order: `rank[i]` is query `i`'s place in `order`.
+        let mut rank = vec![0u32; order.len()];
+        for (k, &i) in order.iter().enumerate() {
+            rank[i as usize] = k as u32;
         }
-        Ok(out)
+        Ok(rank.par_iter().map(|&k| found[k as usize]).collect())
     }
 
     /// Closest points of many queries, in parallel.

@@ -287,13 +287,13 @@ impl PatchTable {
         crate::mesh::check_finite(positions)?;
         self.level_positions = self.to_level.apply(positions)?;
         self.grid_points = self.grid_table.apply(&self.level_positions)?;
-        for patch in &mut self.patches {
+        self.patches.par_iter_mut().for_each(|patch| {
             if let Some(tree) = patch.tree.get_mut() {
                 for points in &mut tree.points {
                     points.take();
                 }
             }
-        }
+        });
         self.positions = positions.to_vec();
         Ok(())
     }
