@@ -27,6 +27,8 @@
 //! Unless at least [`MIN_AGREEMENT`] of the points that reach the outside
 //! one way or the other agree, nothing is carved.
 
+use rayon::prelude::*;
+
 use super::normals::SignedDistance;
 use super::voxels::VoxelGrid;
 use crate::math::{Point3, Real, Vector3};
@@ -59,7 +61,7 @@ pub fn carve(
     normals: &[Vector3],
     sd: &SignedDistance,
     h: Real,
-    world: impl Fn([Real; 3]) -> Point3,
+    world: impl Fn([Real; 3]) -> Point3 + Sync,
     voxel_of: impl Fn(&Point3) -> Option<usize>,
 ) -> CarveStats {
     let outside = solid.outside();
@@ -85,6 +87,7 @@ pub fn carve(
         };
     }
     let remove: Vec<usize> = (0..solid.solid.len())
+        .into_par_iter()
         .filter(|&n| solid.solid[n])
         .filter(|&n| {
             let c = solid.coords(n).map(|x| x as Real);

@@ -40,6 +40,7 @@
 
 use super::frame::PrincipalFrame;
 use crate::math::{Point3, Real, Vector3};
+use rayon::prelude::*;
 
 /// Largest number of points examined; larger clouds are subsampled.
 const MAX_POINTS: usize = 20_000;
@@ -69,9 +70,12 @@ pub fn closedness(points: &[Point3], frame: &PrincipalFrame, threshold: Real) ->
         .map(|p| p - frame.centroid)
         .collect();
     let columns = column_count(sample.len());
+    let fractions: Vec<(Real, Vector3)> = directions(frame)
+        .into_par_iter()
+        .map(|d| (layered_fraction(&sample, &d, columns), d))
+        .collect();
     let mut best = (Real::INFINITY, frame.axes[2]);
-    for d in directions(frame) {
-        let f = layered_fraction(&sample, &d, columns);
+    for (f, d) in fractions {
         if f < best.0 {
             best = (f, d);
         }
