@@ -550,7 +550,7 @@ fn stiffness_and_damping_in_one_pass_equal_the_separate_matrices() {
 /// the pattern is unchanged; a matrix outside the pattern is refused.
 #[test]
 fn patch_assembly_equals_the_sparse_spring_products() {
-    use subdyn::forces::{PatchAssembly, row_springs, spring_system};
+    use subdyn::forces::{PatchAssembly, RowSprings, row_springs, spring_system};
     use subdyn::limit::{ClosestPointEngine, ClosestPointParams};
     let mut seed = 7u64;
     for mesh in [
@@ -583,7 +583,8 @@ fn patch_assembly_equals_the_sparse_spring_products() {
         let k: Vec<Real> = (0..points.len())
             .map(|i| if i % 7 == 0 { 0.0 } else { lcg(&mut seed) })
             .collect();
-        let reference = spring_system(&engine, &points, &closest, &k).unwrap();
+        let data_reference = spring_system(&engine, &points, &closest, &k).unwrap();
+        let reference = data_reference.clone();
         let fast = assembly
             .data_springs(table, &points, &closest, &k, None)
             .unwrap();
@@ -623,6 +624,43 @@ fn patch_assembly_equals_the_sparse_spring_products() {
         assert!(
             m > 0.0 && worst <= 1e-12 * m,
             "row matrix {worst:e} of {m:e}"
+        );
+        // Both kinds in one pass: the sum of the two systems.
+        let both = assembly
+            .data_springs(
+                table,
+                &points,
+                &closest,
+                &k,
+                Some(RowSprings {
+                    rows: &on_patches,
+                    x: &x,
+                    d: &d,
+                    k: &kr,
+                }),
+            )
+            .unwrap();
+        let mut sum = data_reference;
+        sum.add(&reference).unwrap();
+        let (worst, m) = table_difference(&sum.matrix, &both.matrix);
+        assert!(
+            m > 0.0 && worst <= 1e-12 * m,
+            "summed matrix {worst:e} of {m:e}"
+        );
+        for (a, b) in sum.rhs.iter().zip(&both.rhs) {
+            assert!((a - b).norm() <= 1e-12 * scale, "summed rhs {a} vs {b}");
+        }
+        assert!((sum.energy - both.energy).abs() <= 1e-12 * sum.energy);
+        let short = RowSprings {
+            rows: &on_patches,
+            x: &x[1..],
+            d: &d,
+            k: &kr,
+        };
+        assert!(
+            assembly
+                .data_springs(table, &points, &closest, &k, Some(short))
+                .is_err()
         );
         let stiffness = patch_stiffness_matrix(table, 4, &MaterialParams::default()).unwrap();
         let carried = assembly.matrix(assembly.values_of(&stiffness).unwrap());
