@@ -315,22 +315,13 @@ impl PatchAssembly {
                     // through the one-ring of a patch that has the column.
                     let mut rows: Vec<(&[Real], &[u16])> = vec![(&[], &[]); m];
                     for f in lo..hi {
-                        let first = self.ring_offsets[f];
-                        let ring = &self.ring[first..self.ring_offsets[f + 1]];
                         for &col in element(f).0 {
                             let i = union.binary_search(&col).unwrap_or(0);
                             if !rows[i].0.is_empty() {
                                 continue;
                             }
-                            let j = ring.binary_search(&col).map_err(|_| {
-                                Error::Topology(format!(
-                                    "level vertex {col} is outside patch {f}'s one-ring"
-                                ))
-                            })?;
-                            rows[i] = (
-                                s.row(col as usize).1,
-                                &self.ring_positions[self.ring_map[first + j]..],
-                            );
+                            let at = self.ring_places(f, col).ok_or_else(|| outside(f, col))?;
+                            rows[i] = (s.row(col as usize).1, at);
                         }
                     }
                     let b = self.block[lo] as usize;
@@ -431,24 +422,29 @@ impl PatchAssembly {
         u: &mut [Real],
     ) -> Result<()> {
         let s = table.to_level();
-        let first = self.ring_offsets[f];
-        let ring = &self.ring[first..self.ring_offsets[f + 1]];
-        let mut outside = None;
-        table.visit_position_weights(f, st, |c, wc| match ring.binary_search(&c) {
-            Ok(j) => {
-                let at = &self.ring_positions[self.ring_map[first + j]..];
+        let mut missing = None;
+        table.visit_position_weights(f, st, |c, wc| match self.ring_places(f, c) {
+            Some(at) => {
                 for (&x, &a) in s.row(c as usize).1.iter().zip(at) {
                     u[a as usize] += wc * x;
                 }
             }
-            Err(_) => outside = Some(c),
+            None => missing = Some(c),
         });
-        match outside {
-            Some(c) => Err(Error::Topology(format!(
-                "level vertex {c} is outside patch {f}'s one-ring"
-            ))),
+        match missing {
+            Some(c) => Err(outside(f, c)),
             None => Ok(()),
         }
+    }
+
+    /// Where the columns of level vertex `c`'s row of `S` sit in patch
+    /// `f`'s support (from that place on, in the row's order); `None` when
+    /// `c` is not in `f`'s one-ring.
+    fn ring_places(&self, f: usize, c: u32) -> Option<&[u16]> {
+        let first = self.ring_offsets[f];
+        let ring = &self.ring[first..self.ring_offsets[f + 1]];
+        let j = ring.binary_search(&c).ok()?;
+        Some(&self.ring_positions[self.ring_map[first + j]..])
     }
 
     /// The rows over the control points of the limit points `at[i] = (f,
@@ -688,6 +684,11 @@ impl RowSprings<'_> {
         }
         (self.x[i], self.d[i], self.k[i])
     }
+}
+
+/// The error for level vertex `c` outside patch `f`'s one-ring.
+fn outside(f: usize, c: u32) -> Error {
+    Error::Topology(format!("level vertex {c} is outside patch {f}'s one-ring"))
 }
 
 /// The entrywise sum of `parts` (zeros of length `len` if there are none).
