@@ -987,6 +987,18 @@ fn closest_point_engine_set_positions_equals_a_fresh_engine() {
     engine.closest_points(&queries).unwrap();
     engine.set_positions(&moved).unwrap();
     let fresh = ClosestPointEngine::new(&r, &moved, &params).unwrap();
+    // A handful of queries before the seed tree is rebuilt takes the
+    // seed scan instead; it must find what the tree does.
+    let few = engine.closest_points(&queries[..8]).unwrap();
+    for (q, a) in queries.iter().zip(&few) {
+        let b = fresh.closest_point(*q).unwrap();
+        assert!(
+            (a.distance - b.distance).abs() < 1e-12 && (a.point - b.point).norm() < 1e-9,
+            "{q}: scan {} vs tree {}",
+            a.distance,
+            b.distance
+        );
+    }
     for q in &queries {
         let (a, b) = (
             engine.closest_point(*q).unwrap(),

@@ -119,8 +119,8 @@ impl PatchAssembly {
         }
         let support_offsets = offsets_of(supports.iter().map(Vec::len));
         let ring_offsets = offsets_of(rings.iter().map(Vec::len));
-        let ring_positions: Vec<u16> = positions.concat();
-        let ring: Vec<u32> = rings.concat();
+        let ring_positions: Vec<u16> = par_concat(positions);
+        let ring: Vec<u32> = par_concat(rings);
         let ring_map = offsets_of(ring.iter().map(|&w| s.row(w as usize).0.len()));
         let support: Vec<u32> = supports.concat();
         // The patches over each control point, then each row's columns.
@@ -159,7 +159,7 @@ impl PatchAssembly {
             )
             .collect();
         let offsets = offsets_of(rows.iter().map(Vec::len));
-        let indices = rows.concat();
+        let indices = par_concat(rows);
         let per_block: Vec<Vec<u32>> = supports
             .par_iter()
             .map(|sup| {
@@ -194,7 +194,7 @@ impl PatchAssembly {
             ring_map,
             ring_positions,
             slot_offsets,
-            slots: per_block.concat(),
+            slots: par_concat(per_block),
         })
     }
 
@@ -500,11 +500,11 @@ impl PatchAssembly {
         }
         let rows = StencilTable {
             num_cols: self.offsets.len() - 1,
-            offsets: offsets_of(lengths.concat().into_iter()),
-            indices: indices.concat(),
-            weights: weights.concat(),
+            offsets: offsets_of(lengths.into_iter().flatten()),
+            indices: par_concat(indices),
+            weights: par_concat(weights),
         };
-        let places = places.concat();
+        let places = par_concat(places);
         Ok(PatchRows {
             rows,
             patch: at.iter().map(|a| a.0 as u32).collect(),
@@ -541,6 +541,18 @@ impl PatchAssembly {
         for (&slot, &x) in slots.iter().zip(c) {
             values[slot as usize] += x;
         }
+    }
+
+    /// [`scatter`](Self::scatter) of a symmetric sum of which only the
+    /// upper triangle of `c` was summed: the lower is copied from it first.
+    fn scatter_upper(&self, b: usize, c: &mut [Real], values: &mut [Real]) {
+        let m = self.support_of_block(b).len();
+        for a in 1..m {
+            for e in 0..a {
+                c[a * m + e] = c[e * m + a];
+            }
+        }
+        self.scatter(b, c, values);
     }
 
     /// Sums `k uuᵀ`, `k u d` and `½ k |x − d|²` over `count` springs on
@@ -581,7 +593,7 @@ impl PatchAssembly {
                     let m = sup.len();
                     if block != Some(b) {
                         if let Some(done) = block {
-                            self.scatter(done, &c, &mut values);
+                            self.scatter_upper(done, &mut c, &mut values);
                         }
                         block = Some(b);
                         c.clear();
@@ -603,13 +615,14 @@ impl PatchAssembly {
                             continue;
                         }
                         rhs[sup[a] as usize].coords += ka * d.coords;
-                        for (o, &y) in c[a * m..(a + 1) * m].iter_mut().zip(&u[..]) {
+                        // The upper triangle only; mirrored before the scatter.
+                        for (o, &y) in c[a * m + a..(a + 1) * m].iter_mut().zip(&u[a..]) {
                             *o += ka * y;
                         }
                     }
                 }
                 if let Some(done) = block {
-                    self.scatter(done, &c, &mut values);
+                    self.scatter_upper(done, &mut c, &mut values);
                 }
                 Ok((values, rhs, energy))
             })
@@ -700,6 +713,24 @@ fn summed(parts: Vec<Vec<Real>>, len: usize) -> Vec<Real> {
             *a += b;
         }
     }
+    out
+}
+
+/// `parts.concat()`, with the copies and the parts' frees spread over the
+/// thread pool: a serial concatenation of large parts faults the whole
+/// result in, and frees every part, on the caller's thread.
+fn par_concat<T: Copy + Default + Send + Sync>(parts: Vec<Vec<T>>) -> Vec<T> {
+    let mut out = vec![T::default(); parts.iter().map(Vec::len).sum()];
+    let mut rest = out.as_mut_slice();
+    let mut pieces = Vec::with_capacity(parts.len());
+    for part in parts {
+        let (head, tail) = rest.split_at_mut(part.len());
+        pieces.push((head, part));
+        rest = tail;
+    }
+    pieces
+        .into_par_iter()
+        .for_each(|(to, from)| to.copy_from_slice(&from));
     out
 }
 

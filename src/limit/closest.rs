@@ -75,6 +75,10 @@ pub struct ClosestPoint {
     pub patch: (u32, [Real; 2]),
 }
 
+/// At most this many queries are answered without the seed tree when it is
+/// not built yet ([`ClosestPointEngine::closest_points`]).
+const FEW_QUERIES: usize = 32;
+
 /// Closest-point queries against the limit surface of a fixed control mesh.
 pub struct ClosestPointEngine {
     table: PatchTable,
@@ -323,8 +327,44 @@ impl ClosestPointEngine {
 
     /// Closest points of many queries, in parallel.
     pub fn closest_points(&self, queries: &[Point3]) -> Result<Vec<ClosestPoint>> {
+        if self.tree.get().is_none() && queries.len() <= FEW_QUERIES {
+            return self.closest_points_by_scan(queries);
+        }
         self.seed_tree()?;
         queries.par_iter().map(|&q| self.closest_point(q)).collect()
+    }
+
+    /// [`closest_points`](Self::closest_points) for a handful of queries
+    /// while the seed tree is not built: each query's nearest seeds by a
+    /// scan over the seeds, which costs far less than building the tree
+    /// (the same candidates as the tree's but for ties).
+    fn closest_points_by_scan(&self, queries: &[Point3]) -> Result<Vec<ClosestPoint>> {
+        for &q in queries {
+            check_query(q)?;
+        }
+        let seeds: Vec<Point3> = self
+            .seeds
+            .par_iter()
+            .map(|&(f, st)| self.table.position(f as usize, st))
+            .collect::<Result<_>>()?;
+        let k = self.params.candidates.clamp(1, seeds.len().max(1));
+        queries
+            .iter()
+            .map(|&q| {
+                // The k nearest seeds, nearest first.
+                let mut near: Vec<(Real, usize)> = Vec::with_capacity(k + 1);
+                for (i, x) in seeds.iter().enumerate() {
+                    let d = (x - q).norm_squared();
+                    if near.len() < k || d < near[k - 1].0 {
+                        let at = near.partition_point(|e| e.0 <= d);
+                        near.insert(at, (d, i));
+                        near.truncate(k);
+                    }
+                }
+                self.best_descent(q, near.iter().map(|&(_, i)| self.seeds[i]))
+                    .map(|(c, _)| c)
+            })
+            .collect()
     }
 
     /// Projected Newton descent from `(f, st)`, crossing into neighbouring

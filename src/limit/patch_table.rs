@@ -145,6 +145,18 @@ pub struct PatchTable {
     shapes: QuadtreeCache,
 }
 
+impl Drop for PatchTable {
+    /// Frees the patches (their quadtrees and cached points: many small
+    /// allocations) on the thread pool rather than the caller's thread,
+    /// which would otherwise stall on them between fitting levels.
+    fn drop(&mut self) {
+        let patches = std::mem::take(&mut self.patches);
+        if patches.len() >= 4096 {
+            rayon::spawn(move || drop(patches));
+        }
+    }
+}
+
 /// Quadtree leaves by the one-ring's local structure
 /// (`Ring::shape_key`): irregular faces with the same structure
 /// (most faces at extraordinary vertices of one valence) share their
@@ -285,8 +297,23 @@ impl PatchTable {
     /// quadtrees built so far are kept.
     pub fn set_positions(&mut self, positions: &[Point3]) -> Result<()> {
         crate::mesh::check_finite(positions)?;
-        self.level_positions = self.to_level.apply(positions)?;
-        self.grid_points = self.grid_table.apply(&self.level_positions)?;
+        if positions.len() != self.to_level.num_cols {
+            return Err(Error::Input(format!(
+                "{} control points for a patch table over {}",
+                positions.len(),
+                self.to_level.num_cols
+            )));
+        }
+        // Into the buffers already there (sized on the first call): fresh
+        // ones would be zeroed and faulted in on one thread.
+        self.level_positions
+            .resize(self.to_level.num_rows(), Point3::origin());
+        self.grid_points
+            .resize(self.grid_table.num_rows(), Point3::origin());
+        self.to_level
+            .apply_into(positions, &mut self.level_positions);
+        self.grid_table
+            .apply_into(&self.level_positions, &mut self.grid_points);
         self.patches.par_iter_mut().for_each(|patch| {
             if let Some(tree) = patch.tree.get_mut() {
                 for points in &mut tree.points {
@@ -294,7 +321,8 @@ impl PatchTable {
                 }
             }
         });
-        self.positions = positions.to_vec();
+        self.positions.clear();
+        self.positions.extend_from_slice(positions);
         Ok(())
     }
 
