@@ -238,7 +238,8 @@ impl PatchAssembly {
     /// `Σ_f S_fᵀ E_f S_f` in the pattern's order, for each of `N` sets of
     /// elements at once: the dense elements `element(f) = (cols, [E_f, …])`
     /// of every patch `f` over level-`L` vertices of its one-ring (`cols`
-    /// sorted, each `E_f` row-major), carried to the control points through
+    /// sorted, each `E_f` row-major and symmetric, as stiffness, damping
+    /// and mass elements are), carried to the control points through
     /// the patch's rows `S_f` of `S` — the finite-element scatter and
     /// `Sᵀ K_L S` in one pass. The patches of a block (a control face's
     /// corners at level 1) are first summed over the union of their columns
@@ -268,10 +269,11 @@ impl PatchAssembly {
             .map(|runs| {
                 let mut values: [Vec<Real>; N] =
                     std::array::from_fn(|_| vec![0.0; self.indices.len()]);
-                let (mut union, mut at, mut e, mut t, mut c) = (
+                let (mut union, mut at, mut e, mut t, mut c, mut col) = (
                     Vec::new(),
                     Vec::new(),
                     std::array::from_fn::<_, N, _>(|_| Vec::new()),
+                    Vec::new(),
                     Vec::new(),
                     Vec::new(),
                 );
@@ -327,24 +329,29 @@ impl PatchAssembly {
                     let b = self.block[lo] as usize;
                     let n = self.support_of_block(b).len();
                     for (e, values) in e.iter().zip(&mut values) {
-                        // T = E S (m × n), then C = Sᵀ T (n × n).
+                        // T = E S (m × n), stored by columns (`t[b m + i]`)
+                        // so both products run over contiguous rows; `E` is
+                        // symmetric, so its column `j` is its row `j`.
                         t.clear();
                         t.resize(m * n, 0.0);
                         for (j, (w, at)) in rows.iter().enumerate() {
+                            let ej = &e[j * m..(j + 1) * m];
                             for (&x, &b) in w.iter().zip(*at) {
-                                for i in 0..m {
-                                    t[i * n + b as usize] += e[i * m + j] * x;
+                                let b = b as usize;
+                                for (o, &y) in t[b * m..(b + 1) * m].iter_mut().zip(ej) {
+                                    *o += x * y;
                                 }
                             }
                         }
+                        // C = Sᵀ T (n × n), from each row `i` of T at once.
                         c.clear();
                         c.resize(n * n, 0.0);
                         for (i, (w, at)) in rows.iter().enumerate() {
+                            col.clear();
+                            col.extend((0..n).map(|b| t[b * m + i]));
                             for (&x, &a) in w.iter().zip(*at) {
                                 let a = a as usize;
-                                for (o, &y) in
-                                    c[a * n..(a + 1) * n].iter_mut().zip(&t[i * n..(i + 1) * n])
-                                {
+                                for (o, &y) in c[a * n..(a + 1) * n].iter_mut().zip(&col) {
                                     *o += x * y;
                                 }
                             }
