@@ -51,6 +51,11 @@ pub struct PatchAssembly {
     ring: Vec<u32>,
     ring_map: Vec<usize>,
     ring_positions: Vec<u16>,
+    /// For each patch, where the terms of each of its position columns
+    /// (`PatchTable::position_columns`) start among its `ring_positions`,
+    /// patch after patch (`u16::MAX` for a column outside the ring).
+    column_offsets: Vec<usize>,
+    column_places: Vec<u16>,
     /// For block `b` with support of size `m`: `m × m` positions in the
     /// pattern, row-major, starting at `slot_offsets[b]`.
     slot_offsets: Vec<usize>,
@@ -66,7 +71,8 @@ impl PatchAssembly {
         // Per thread: `seen[c]` is the last patch whose support took control
         // point `c`, `at[c]` its position there.
         let scratch = || (vec![u32::MAX; n], vec![0u32; n]);
-        let rings: Vec<(Vec<u32>, Vec<u32>, Vec<u16>)> = (0..table.num_patches())
+        type Ring = (Vec<u32>, Vec<u32>, Vec<u16>, Vec<u16>);
+        let rings: Vec<Ring> = (0..table.num_patches())
             .into_par_iter()
             .map_init(scratch, |(seen, at), f| {
                 let mut ring = Vec::with_capacity(16);
@@ -97,12 +103,35 @@ impl PatchAssembly {
                     .flat_map(|&w| s.row(w as usize).0)
                     .map(|&c| at[c as usize] as u16)
                     .collect();
-                (ring, sup, at)
+                // Where each of the patch's position columns starts in `at`
+                // (`u16::MAX` for one outside the ring).
+                let mut start = 0;
+                let starts: Vec<usize> = ring
+                    .iter()
+                    .map(|&w| {
+                        start += s.row(w as usize).0.len();
+                        start - s.row(w as usize).0.len()
+                    })
+                    .collect();
+                let columns: Vec<u16> = table
+                    .position_columns(f)
+                    .iter()
+                    .map(|c| ring.binary_search(c).map_or(u16::MAX, |j| starts[j] as u16))
+                    .collect();
+                (ring, sup, at, columns)
             })
             .collect();
         let (mut ring_lists, mut supports, mut positions) = (Vec::new(), Vec::new(), Vec::new());
+        let mut columns = Vec::with_capacity(rings.len());
         let mut block = Vec::with_capacity(rings.len());
-        for (ring, sup, at) in rings {
+        for (ring, sup, at, cols) in rings {
+            if at.len() >= u16::MAX as usize {
+                return Err(Error::Input(format!(
+                    "a patch's one-ring has {} control-point terms, more than 65,534",
+                    at.len()
+                )));
+            }
+            columns.push(cols);
             if supports.last() != Some(&sup) {
                 supports.push(sup);
             }
@@ -119,6 +148,8 @@ impl PatchAssembly {
         }
         let support_offsets = offsets_of(supports.iter().map(Vec::len));
         let ring_offsets = offsets_of(rings.iter().map(Vec::len));
+        let column_offsets = offsets_of(columns.iter().map(Vec::len));
+        let column_places = par_concat(columns);
         let ring_positions: Vec<u16> = par_concat(positions);
         let ring: Vec<u32> = par_concat(rings);
         let ring_map = offsets_of(ring.iter().map(|&w| s.row(w as usize).0.len()));
@@ -193,6 +224,8 @@ impl PatchAssembly {
             ring,
             ring_map,
             ring_positions,
+            column_offsets,
+            column_places,
             slot_offsets,
             slots: par_concat(per_block),
         })
@@ -430,13 +463,22 @@ impl PatchAssembly {
     ) -> Result<()> {
         let s = table.to_level();
         let mut missing = None;
-        table.visit_position_weights(f, st, |c, wc| match self.ring_places(f, c) {
-            Some(at) => {
-                for (&x, &a) in s.row(c as usize).1.iter().zip(at) {
-                    u[a as usize] += wc * x;
+        let places = &self.column_places[self.column_offsets[f]..self.column_offsets[f + 1]];
+        // The patch's places start where its first ring vertex's do.
+        let base = self.ring_map[self.ring_offsets[f]];
+        table.visit_position_terms(f, st, |k, c, wc| {
+            let at = match k.map(|k| places[k]) {
+                Some(p) if p != u16::MAX => Some(&self.ring_positions[base + p as usize..]),
+                _ => self.ring_places(f, c),
+            };
+            match at {
+                Some(at) => {
+                    for (&x, &a) in s.row(c as usize).1.iter().zip(at) {
+                        u[a as usize] += wc * x;
+                    }
                 }
+                None => missing = Some(c),
             }
-            None => missing = Some(c),
         });
         match missing {
             Some(c) => Err(outside(f, c)),

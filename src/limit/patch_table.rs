@@ -480,14 +480,41 @@ impl PatchTable {
         st: [Real; 2],
         mut visit: impl FnMut(u32, Real),
     ) {
+        self.visit_position_terms(f, st, |_, c, w| visit(c, w));
+    }
+
+    /// The level-`L` columns of patch `f`'s position stencils, in a fixed
+    /// order: [`visit_position_terms`](Self::visit_position_terms) names
+    /// its terms by their places in this list. Builds (and keeps) an
+    /// irregular patch's quadtree.
+    pub fn position_columns(&self, f: usize) -> &[u32] {
+        let patch = &self.patches[f];
+        if patch.regular {
+            let g = &self.grid_table;
+            return &g.indices[g.offsets[16 * f]..g.offsets[16 * f + 16]];
+        }
+        &patch.tree.get_or_init(|| self.tree(f)).cols
+    }
+
+    /// [`visit_position_weights`](Self::visit_position_weights), also
+    /// handing each term's place in [`position_columns`](Self::position_columns)
+    /// (`None` for the terms of the exact evaluation at an irregular
+    /// vertex itself, which the quadtree leaves out).
+    pub fn visit_position_terms(
+        &self,
+        f: usize,
+        st: [Real; 2],
+        mut visit: impl FnMut(Option<usize>, u32, Real),
+    ) {
         let patch = &self.patches[f];
         if patch.regular {
             let w = position_weights(st[0].clamp(0.0, 1.0), st[1].clamp(0.0, 1.0));
+            let g = &self.grid_table;
+            let first = g.offsets[16 * f];
             for (i, &wi) in w.iter().enumerate() {
                 if wi != 0.0 {
-                    let (cols, ws) = self.grid_table.row(16 * f + i);
-                    for (&c, &x) in cols.iter().zip(ws) {
-                        visit(c, wi * x);
+                    for e in g.offsets[16 * f + i]..g.offsets[16 * f + i + 1] {
+                        visit(Some(e - first), g.indices[e], wi * g.weights[e]);
                     }
                 }
             }
@@ -498,13 +525,13 @@ impl PatchTable {
         if let Some((_, _, rows, x)) = tree.leaf_at(st) {
             let w = position_weights(x[0], x[1]);
             for (k, &c) in tree.cols.iter().enumerate() {
-                visit(c, (0..16).map(|i| w[i] * rows[i * nc + k]).sum());
+                visit(Some(k), c, (0..16).map(|i| w[i] * rows[i * nc + k]).sum());
             }
             return;
         }
         let s = evaluate_face(&self.level, &self.sharp, f, st[0], st[1]);
         for (&c, &w) in s.cols.iter().zip(&s.weights[0]) {
-            visit(c, w);
+            visit(None, c, w);
         }
     }
 
