@@ -597,8 +597,12 @@ fn patch_assembly_equals_the_sparse_spring_products() {
 
         // Rows already over the control points (as the surface samples are).
         let s = table.to_level();
+        // Inside the patches, and at every patch's corners (at an irregular
+        // vertex itself the quadtree gives way to exact evaluation).
+        let corners = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]];
         let at: Vec<(usize, [Real; 2])> = (0..200)
             .map(|i| (i % table.num_patches(), [lcg(&mut seed), lcg(&mut seed)]))
+            .chain((0..table.num_patches()).flat_map(|f| corners.map(|st| (f, st))))
             .collect();
         let mut rows = StencilTable::with_capacity(s.num_rows(), at.len(), 0);
         for &(f, st) in &at {
