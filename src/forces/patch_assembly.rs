@@ -198,9 +198,13 @@ impl PatchAssembly {
                 for &a in sup {
                     let (lo, hi) = (offsets[a as usize], offsets[a as usize + 1]);
                     let row = &indices[lo..hi];
+                    // Both sorted: one merge. Every `b` is present by
+                    // construction (it shares this patch with `a`).
+                    let mut k = 0;
                     for b in sup {
-                        // Present by construction: `b` shares this patch with `a`.
-                        let k = row.binary_search(b).unwrap_or(0);
+                        while k + 1 < row.len() && row[k] < *b {
+                            k += 1;
+                        }
                         out.push((lo + k) as u32);
                     }
                 }
