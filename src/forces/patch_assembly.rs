@@ -105,14 +105,12 @@ impl PatchAssembly {
                     .collect();
                 // Where each of the patch's position columns starts in `at`
                 // (`u16::MAX` for one outside the ring).
+                let mut starts = Vec::with_capacity(ring.len());
                 let mut start = 0;
-                let starts: Vec<usize> = ring
-                    .iter()
-                    .map(|&w| {
-                        start += s.row(w as usize).0.len();
-                        start - s.row(w as usize).0.len()
-                    })
-                    .collect();
+                for &w in &ring {
+                    starts.push(start);
+                    start += s.row(w as usize).0.len();
+                }
                 let columns: Vec<u16> = table
                     .position_columns(f)
                     .iter()
