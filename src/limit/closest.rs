@@ -174,13 +174,21 @@ impl ClosestPointEngine {
             return Ok(tree);
         }
         let pts: Vec<[Real; 3]> = self
-            .seeds
-            .par_iter()
-            .map(|&(f, st)| self.table.position(f as usize, st).map(|p| [p.x, p.y, p.z]))
-            .collect::<Result<_>>()?;
+            .seed_positions()?
+            .iter()
+            .map(|p| [p.x, p.y, p.z])
+            .collect();
         Ok(self
             .tree
             .get_or_init(|| ImmutableKdTree::new_from_slice(&pts)))
+    }
+
+    /// The seeds' positions on the surface, in parallel.
+    fn seed_positions(&self) -> Result<Vec<Point3>> {
+        self.seeds
+            .par_iter()
+            .map(|&(f, st)| self.table.position(f as usize, st))
+            .collect()
     }
 
     /// The closest limit-surface point to `q`.
@@ -342,11 +350,7 @@ impl ClosestPointEngine {
         for &q in queries {
             check_query(q)?;
         }
-        let seeds: Vec<Point3> = self
-            .seeds
-            .par_iter()
-            .map(|&(f, st)| self.table.position(f as usize, st))
-            .collect::<Result<_>>()?;
+        let seeds = self.seed_positions()?;
         let k = self.params.candidates.clamp(1, seeds.len().max(1));
         queries
             .iter()
