@@ -89,17 +89,10 @@ fn main() -> subdyn::Result<()> {
     frames.push(picture(&end, "plastic, extruded")?);
     subdyn::io::write_mesh("sculpt_cube.obj", &end, None)?;
 
-    let mut strip = Picture::new(320 * frames.len() as u32, 300, [255, 255, 255])?;
-    for (k, f) in frames.iter().enumerate() {
-        for y in 0..300 {
-            for x in 0..320 {
-                if let Some(c) = f.get(x, y) {
-                    strip.set(i64::from(320 * k as u32 + x), i64::from(y), c);
-                }
-            }
-        }
-    }
-    write_png(std::path::Path::new("sculpt_cube.png"), &strip)?;
+    write_png(
+        std::path::Path::new("sculpt_cube.png"),
+        &Picture::side_by_side(&frames)?,
+    )?;
     println!("wrote sculpt_cube.obj and sculpt_cube.png");
     Ok(())
 }

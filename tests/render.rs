@@ -597,3 +597,20 @@ fn cli_rejects_bad_sizes_views_and_outputs_with_one_line_and_no_file() {
         "out.png",
     );
 }
+
+#[test]
+fn pictures_side_by_side_keep_their_pixels_and_places() {
+    let mut a = Picture::new(3, 2, [10, 10, 10]).unwrap();
+    a.set(2, 1, [1, 2, 3]);
+    let mut b = Picture::new(2, 4, [20, 20, 20]).unwrap();
+    b.set(0, 3, [4, 5, 6]);
+    let s = Picture::side_by_side(&[a, b]).unwrap();
+    assert_eq!((s.width(), s.height()), (5, 4));
+    assert_eq!(s.get(2, 1), Some([1, 2, 3]));
+    assert_eq!(s.get(3, 3), Some([4, 5, 6]));
+    assert_eq!(s.get(0, 0), Some([10, 10, 10]));
+    assert_eq!(s.get(4, 0), Some([20, 20, 20]));
+    // Below the shorter picture: the white background.
+    assert_eq!(s.get(1, 3), Some([255, 255, 255]));
+    assert!(Picture::side_by_side(&[]).is_err());
+}

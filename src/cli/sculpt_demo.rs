@@ -71,8 +71,8 @@ pub fn write_strip(snapshots: &[Snapshot], path: &Path) -> anyhow::Result<()> {
         .collect();
     let frame_box = PolyMesh::from_faces(corners, &[vec![0, 1, 3, 2], vec![4, 6, 7, 5]])?;
     let (w, h) = (300u32, 280u32);
-    let mut strip = Picture::new(w * snapshots.len() as u32, h, [255, 255, 255])?;
-    for (k, s) in snapshots.iter().enumerate() {
+    let mut frames = Vec::with_capacity(snapshots.len());
+    for s in snapshots {
         let caption = super::sculpt_demo::DEMO_SNAPSHOTS
             .iter()
             .find(|d| d.0 == s.step)
@@ -107,15 +107,8 @@ pub fn write_strip(snapshots: &[Snapshot], path: &Path) -> anyhow::Result<()> {
             margin: 0.02,
             ..RenderOptions::default()
         };
-        let pic = render(&scene, &options)?;
-        for y in 0..h {
-            for x in 0..w {
-                if let Some(c) = pic.get(x, y) {
-                    strip.set(i64::from(k as u32 * w + x), i64::from(y), c);
-                }
-            }
-        }
+        frames.push(render(&scene, &options)?);
     }
-    write_png(path, &strip)?;
+    write_png(path, &Picture::side_by_side(&frames)?)?;
     Ok(())
 }

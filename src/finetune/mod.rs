@@ -3,8 +3,8 @@
 //!
 //! Curves: a new curve `Q` with `Q'(t) = α(t) P'(t)`, closed curves closed
 //! again by the spring energy (13) minimised by Levenberg-Marquardt
-//! (`levenberg_marquardt`, `sparse_cholesky`, `min_degree`,
-//! `angle_curvature`) or argmin's nonlinear CG. Files:
+//! (`levenberg_marquardt`, `sparse_cholesky` with the stencil module's
+//! nested-dissection ordering, `angle_curvature`) or argmin's nonlinear CG. Files:
 //! `curve_alpha` (α from control values), `curve_exact` (exact product and
 //! integral as a B-spline), `curve_bspline` (evaluation), `curve_energy`
 //! (eq. 13), `curve_frames` (fixed point and rotation), `curve_solver` (argmin
@@ -31,8 +31,6 @@ mod curve_picture;
 mod curve_solver;
 mod edge_loops;
 mod levenberg_marquardt;
-mod min_degree;
-mod nested_dissection;
 mod refined_step;
 mod sparse_cholesky;
 mod surface;

@@ -58,6 +58,23 @@ impl Picture {
         })
     }
 
+    /// The pictures in a row, left to right, top-aligned on a white
+    /// background (at least one picture).
+    pub fn side_by_side(pictures: &[Picture]) -> Result<Picture> {
+        let width = pictures.iter().map(|p| p.width).sum();
+        let height = pictures.iter().map(|p| p.height).max().unwrap_or(0);
+        let mut strip = Picture::new(width, height, [255, 255, 255])?;
+        let mut x0 = 0;
+        for p in pictures {
+            for (y, row) in p.pixels.chunks(p.width as usize).enumerate() {
+                let start = y * width as usize + x0;
+                strip.pixels[start..start + row.len()].copy_from_slice(row);
+            }
+            x0 += p.width as usize;
+        }
+        Ok(strip)
+    }
+
     /// Width in pixels.
     pub fn width(&self) -> u32 {
         self.width

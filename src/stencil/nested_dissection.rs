@@ -6,7 +6,8 @@
 //! after it, because graph edges join only neighbouring levels); both sides
 //! are ordered recursively and the separator last. Parts of at most
 //! [`LEAF`] nodes, or too shallow to split, are ordered by minimum degree.
-//! On the mesh-like graphs of surface fine tuning this costs a few
+//! Used by both sparse Cholesky solvers (fine tuning's and the dynamic
+//! surfaces'). On the mesh-like graphs of surface fine tuning this costs a few
 //! breadth-first searches instead of the clique merges of minimum degree
 //! over the whole graph.
 

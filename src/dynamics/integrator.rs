@@ -1,0 +1,308 @@
+//! Implicit time integration of a dynamic Catmull-Clark surface (Qin,
+//! Mandal, Vemuri 1998, eq. 16 and §III-C) for interactive use: a drag
+//! spring, inflation or any other load, step after step.
+//!
+//! With `p̈ ≈ (p⁺ − 2p + p⁻)/Δt²` and `ṗ ≈ (p⁺ − p)/Δt` the paper's
+//! `M p̈ + D ṗ + K p = f_p` becomes one linear system per step,
+//!
+//! `(M/Δt² + D/Δt + K + S) p⁺ = M (2p − p⁻)/Δt² + D p/Δt + f`,
+//!
+//! where `S` is the stiffness of implicit springs (`Σ k JᵀJ`, a drag
+//! spring's or data springs') and `f` the load (the springs' `Σ k Jᵀ d` plus
+//! explicit forces such as inflation). Without a mass it is the first-order
+//! (massless) dynamics `D ṗ + K p = f_p`. Both are backward Euler steps and
+//! dissipate: multiplying the step by `p⁺ − p` gives, for a fixed `S` and
+//! `f`, `E(p⁺, p) − E(p, p⁻) = −½‖v⁺ − v‖²_M − Δt‖v⁺‖²_D − ½‖p⁺ − p‖²_{K+S}`
+//! with `E(p, p⁻) = ½ vᵀ M v + ½ pᵀ (K + S) p − fᵀ p`, `v = (p − p⁻)/Δt`
+//! ([`SurfaceDynamics::energy`]): the energy never rises, which is what
+//! equilibrium detection by energy change relies on.
+//!
+//! The step's matrix changes only when `S` does. [`LinearSolver::Cholesky`]
+//! factors it then and reuses the factor for every step with the same
+//! matrix (a drag spring held at one surface point while its target moves):
+//! two triangular solves per step. [`LinearSolver::Pcg`] solves each step by
+//! conjugate gradients from the current positions, which suits a matrix that
+//! changes every step (the fit's data springs).
+
+use crate::error::{Error, Result};
+use crate::limit::PatchTable;
+use crate::math::{Point3, Real};
+use crate::stencil::StencilTable;
+
+use super::cholesky::SparseCholesky;
+use super::elements::{patch_damping_matrix, patch_stiffness_matrix};
+use super::matrices::MaterialParams;
+use super::pcg::{PcgParams, pcg};
+
+/// How an implicit step's linear system is solved.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LinearSolver {
+    /// Jacobi-preconditioned conjugate gradients from the current positions.
+    Pcg(PcgParams),
+    /// Sparse Cholesky, factored when the step's matrix changes and reused
+    /// while it does not.
+    Cholesky,
+}
+
+/// What one step did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepReport {
+    /// [`SurfaceDynamics::energy`] after the step.
+    pub energy: Real,
+    /// Its change over the step relative to its size before (the
+    /// equilibrium test: settled when below a tolerance).
+    pub relative_change: Real,
+    /// Conjugate-gradient iterations (0 with Cholesky).
+    pub cg_iterations: usize,
+    /// True when the step factored its matrix (Cholesky only).
+    pub factored: bool,
+}
+
+/// A dynamic surface: mass, damping and stiffness over its control points,
+/// its positions now and one step before, and the solver's state.
+#[derive(Clone, Debug)]
+pub struct SurfaceDynamics {
+    mass: Option<StencilTable>,
+    damping: StencilTable,
+    stiffness: StencilTable,
+    /// `M/Δt² + D/Δt + K`.
+    base: StencilTable,
+    dt: Real,
+    solver: LinearSolver,
+    p: Vec<Point3>,
+    p_before: Vec<Point3>,
+    /// The matrix factored last and its factor.
+    factored: Option<(StencilTable, SparseCholesky)>,
+    factorizations: usize,
+}
+
+impl SurfaceDynamics {
+    /// A surface at rest at `positions` with mass `mass` (`∫∫ μ JᵀJ`; `None`:
+    /// the first-order, massless dynamics), damping `damping` (`∫∫ γ JᵀJ`)
+    /// and stiffness `stiffness` (all `n × n` over the `n` control points),
+    /// stepped by `dt`.
+    pub fn new(
+        mass: Option<StencilTable>,
+        damping: StencilTable,
+        stiffness: StencilTable,
+        positions: Vec<Point3>,
+        dt: Real,
+        solver: LinearSolver,
+    ) -> Result<SurfaceDynamics> {
+        let n = positions.len();
+        for (name, m) in [("damping", Some(&damping)), ("stiffness", Some(&stiffness))]
+            .into_iter()
+            .chain([("mass", mass.as_ref())])
+        {
+            if let Some(m) = m
+                && (m.num_rows() != n || m.num_cols != n)
+            {
+                return Err(Error::Input(format!(
+                    "dynamics: the {name} matrix is {} × {} for {n} control points",
+                    m.num_rows(),
+                    m.num_cols
+                )));
+            }
+        }
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(Error::Input(format!(
+                "dynamics: time step {dt} must be positive"
+            )));
+        }
+        if let Some(i) = positions
+            .iter()
+            .position(|p| !p.coords.iter().all(|c| c.is_finite()))
+        {
+            return Err(Error::Input(format!(
+                "dynamics: control point {i} is not finite"
+            )));
+        }
+        let mut base = stiffness.linear_combination(1.0, &damping, 1.0 / dt)?;
+        if let Some(m) = &mass {
+            base = base.linear_combination(1.0, m, 1.0 / (dt * dt))?;
+        }
+        Ok(SurfaceDynamics {
+            mass,
+            damping,
+            stiffness,
+            base,
+            dt,
+            solver,
+            p_before: positions.clone(),
+            p: positions,
+            factored: None,
+            factorizations: 0,
+        })
+    }
+
+    /// [`SurfaceDynamics::new`] with the matrices assembled patch by patch
+    /// over `table` (the closest-point engine's patches) with
+    /// Gauss-Legendre `order` × `order` points per polynomial piece:
+    /// `M` from `material.mu` (none when 0), `D` from `material.gamma`, `K`
+    /// from the thin plate's `α` and `β` (all over `du dv`).
+    pub fn on_patches(
+        table: &PatchTable,
+        positions: Vec<Point3>,
+        material: &MaterialParams,
+        order: usize,
+        dt: Real,
+        solver: LinearSolver,
+    ) -> Result<SurfaceDynamics> {
+        let mass = if material.mu > 0.0 {
+            Some(patch_damping_matrix(table, order, material.mu)?)
+        } else {
+            None
+        };
+        let damping = patch_damping_matrix(table, order, material.gamma)?;
+        let stiffness = patch_stiffness_matrix(table, order, material)?;
+        SurfaceDynamics::new(mass, damping, stiffness, positions, dt, solver)
+    }
+
+    /// The control points now.
+    pub fn positions(&self) -> &[Point3] {
+        &self.p
+    }
+
+    /// Sets the control points (a jump: the surface is at rest there).
+    pub fn set_positions(&mut self, positions: &[Point3]) -> Result<()> {
+        if positions.len() != self.p.len() {
+            return Err(Error::Input(format!(
+                "dynamics: {} positions for {} control points",
+                positions.len(),
+                self.p.len()
+            )));
+        }
+        self.p = positions.to_vec();
+        self.p_before = positions.to_vec();
+        Ok(())
+    }
+
+    /// Matrices factored so far (Cholesky only).
+    pub fn factorizations(&self) -> usize {
+        self.factorizations
+    }
+
+    /// `E = ½ vᵀ M v + ½ pᵀ (K + S) p − fᵀ p` with `v = (p − p⁻)/Δt`: kinetic
+    /// plus potential energy for implicit stiffness `springs` (`S`, `None`:
+    /// none) and load `load` (`f`), up to a constant (with data springs the
+    /// potential part is `½ pᵀ K p + ½ Σ k |J p − d|²` less `½ Σ k |d|²`).
+    pub fn energy(&self, springs: Option<&StencilTable>, load: &[Point3]) -> Result<Real> {
+        self.check_load(springs, load)?;
+        let dot = |a: &[Point3], b: &[Point3]| -> Real {
+            a.iter().zip(b).map(|(a, b)| a.coords.dot(&b.coords)).sum()
+        };
+        let mut e = 0.5 * dot(&self.stiffness.apply(&self.p)?, &self.p) - dot(load, &self.p);
+        if let Some(s) = springs {
+            e += 0.5 * dot(&s.apply(&self.p)?, &self.p);
+        }
+        if let Some(m) = &self.mass {
+            let v: Vec<Point3> = self
+                .p
+                .iter()
+                .zip(&self.p_before)
+                .map(|(a, b)| Point3::from((a - b) / self.dt))
+                .collect();
+            e += 0.5 * dot(&m.apply(&v)?, &v);
+        }
+        Ok(e)
+    }
+
+    /// One implicit step with implicit stiffness `springs` (`S`) and load
+    /// `load` (`f`, one vector per control point).
+    pub fn step(&mut self, springs: Option<&StencilTable>, load: &[Point3]) -> Result<StepReport> {
+        let before = self.energy(springs, load)?;
+        let a = match springs {
+            Some(s) => self.base.linear_combination(1.0, s, 1.0)?,
+            None => self.base.clone(),
+        };
+        let mut rhs = self.damping.apply(&self.p)?;
+        for (r, f) in rhs.iter_mut().zip(load) {
+            r.coords = r.coords / self.dt + f.coords;
+        }
+        if let Some(m) = &self.mass {
+            let inertia: Vec<Point3> = self
+                .p
+                .iter()
+                .zip(&self.p_before)
+                .map(|(a, b)| Point3::from((2.0 * a.coords - b.coords) / (self.dt * self.dt)))
+                .collect();
+            for (r, x) in rhs.iter_mut().zip(m.apply(&inertia)?) {
+                r.coords += x.coords;
+            }
+        }
+        let (next, cg_iterations, factored) = match self.solver {
+            LinearSolver::Pcg(params) => {
+                let mut x = self.p.clone();
+                let report = pcg(&a, &rhs, &mut x, &params)?;
+                if !report.converged {
+                    return Err(Error::NotConverged(format!(
+                        "dynamics: conjugate gradients stopped at relative residual {:e} after {} iterations",
+                        report.relative_residual, report.iterations
+                    )));
+                }
+                (x, report.iterations, false)
+            }
+            LinearSolver::Cholesky => {
+                let same = self.factored.as_ref().is_some_and(|(f, _)| {
+                    f.offsets == a.offsets && f.indices == a.indices && f.weights == a.weights
+                });
+                if !same {
+                    match &mut self.factored {
+                        Some((f, factor)) => {
+                            factor.refactor(&a)?;
+                            *f = a;
+                        }
+                        None => self.factored = Some((a.clone(), SparseCholesky::new(&a)?)),
+                    }
+                    self.factorizations += 1;
+                }
+                let (_, factor) = self.factored.as_ref().expect("factored above");
+                (factor.solve(&rhs)?, 0, !same)
+            }
+        };
+        if let Some(i) = next
+            .iter()
+            .position(|p| !p.coords.iter().all(|c| c.is_finite()))
+        {
+            return Err(Error::NotConverged(format!(
+                "dynamics: the step gave a non-finite position at control point {i}"
+            )));
+        }
+        self.p_before = std::mem::replace(&mut self.p, next);
+        let energy = self.energy(springs, load)?;
+        Ok(StepReport {
+            energy,
+            relative_change: (before - energy).abs() / before.abs().max(Real::MIN_POSITIVE),
+            cg_iterations,
+            factored,
+        })
+    }
+
+    fn check_load(&self, springs: Option<&StencilTable>, load: &[Point3]) -> Result<()> {
+        let n = self.p.len();
+        if load.len() != n {
+            return Err(Error::Input(format!(
+                "dynamics: a load of {} vectors for {n} control points",
+                load.len()
+            )));
+        }
+        if let Some(i) = load
+            .iter()
+            .position(|f| !f.coords.iter().all(|c| c.is_finite()))
+        {
+            return Err(Error::Input(format!(
+                "dynamics: the load on control point {i} is not finite"
+            )));
+        }
+        if let Some(s) = springs
+            && (s.num_rows() != n || s.num_cols != n)
+        {
+            return Err(Error::Input(format!(
+                "dynamics: a spring matrix of {} × {} for {n} control points",
+                s.num_rows(),
+                s.num_cols
+            )));
+        }
+        Ok(())
+    }
+}
