@@ -80,7 +80,7 @@ fn main() -> subdyn::Result<()> {
         solvers.push(SurfaceDynamics::on_patches(
             engine.table(),
             mesh.positions.clone(),
-            &material,
+            &[material],
             4,
             dt,
             solver,

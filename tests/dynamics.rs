@@ -6,8 +6,8 @@ mod common;
 use common::{default_refiner, reference_mesh};
 use subdyn::dynamics::{
     MaterialParams, PcgParams, damping_matrix, gauss_legendre, mass_matrix, patch_damping_matrix,
-    patch_sample_rows, patch_samples, patch_stiffness_and_damping, patch_stiffness_matrix, pcg,
-    quadrature, stiffness_and_damping_elements, stiffness_matrix,
+    patch_matrices, patch_sample_rows, patch_samples, patch_stiffness_and_damping,
+    patch_stiffness_matrix, pcg, quadrature, stiffness_and_damping_elements, stiffness_matrix,
 };
 use subdyn::limit::{LimitEvaluator, PatchTable, tessellate};
 use subdyn::math::{Point3, Real};
@@ -699,4 +699,76 @@ fn patch_assembly_equals_the_sparse_spring_products() {
     let x = on_last.rows().apply(&grid.positions).unwrap();
     assert!(assembly.row_springs(&on_last, &x, &x, &[1.0]).is_ok());
     assert!(assembly.rows_at(&table, &[(last + 1, [0.5, 0.5])]).is_err());
+}
+
+/// Materials per base face: one material for every face gives the
+/// constant-material matrices; `M` sums to `Σ_f μ_f` (each quad face has
+/// parameter area 1 and the basis sums to 1); the matrices add over a split
+/// of the faces; a face's bad material is named.
+#[test]
+fn materials_per_face() {
+    let mesh = refined_cube();
+    let faces = mesh.num_faces();
+    let table = PatchTable::new(&default_refiner(&mesh), &mesh.positions, 1).unwrap();
+    let worst = |a: &StencilTable, b: &StencilTable| {
+        let (a, b) = (dense(a), dense(b));
+        a.iter()
+            .flatten()
+            .zip(b.iter().flatten())
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, Real::max)
+    };
+    let one = MaterialParams::default();
+    let [m, d, k] = patch_matrices(&table, 4, &[one]).unwrap();
+    assert!(worst(&m, &patch_damping_matrix(&table, 4, one.mu).unwrap()) < 1e-13);
+    assert!(worst(&d, &patch_damping_matrix(&table, 4, one.gamma).unwrap()) < 1e-13);
+    assert!(worst(&k, &patch_stiffness_matrix(&table, 4, &one).unwrap()) < 1e-13);
+
+    let per: Vec<MaterialParams> = (0..faces)
+        .map(|f| MaterialParams {
+            mu: 1.0 + 0.1 * f as Real,
+            alpha11: 0.01 * (f % 2) as Real,
+            beta22: 0.001 * (1 + f % 5) as Real,
+            ..one
+        })
+        .collect();
+    let [mp, dp, kp] = patch_matrices(&table, 4, &per).unwrap();
+    let total: Real = mp.weights.iter().sum();
+    let expected: Real = per.iter().map(|m| m.mu).sum();
+    assert!(
+        (total - expected).abs() < 1e-10 * expected,
+        "{total} vs {expected}"
+    );
+    assert!(worst(&dp, &d) < 1e-13, "γ is the same on every face");
+    assert!(worst(&kp, &k) > 1e-4, "the faces' elasticities must show");
+    assert_symmetric(&kp, "per-face K");
+
+    let zero = MaterialParams {
+        mu: 0.0,
+        gamma: 0.0,
+        alpha11: 0.0,
+        alpha22: 0.0,
+        beta11: 0.0,
+        beta12: 0.0,
+        beta22: 0.0,
+    };
+    let half = |even: bool| -> Vec<MaterialParams> {
+        (0..faces)
+            .map(|f| if (f % 2 == 0) == even { per[f] } else { zero })
+            .collect()
+    };
+    let [ma, _, ka] = patch_matrices(&table, 4, &half(true)).unwrap();
+    let [mb, _, kb] = patch_matrices(&table, 4, &half(false)).unwrap();
+    let sum = |a: &StencilTable, b: &StencilTable| a.linear_combination(1.0, b, 1.0).unwrap();
+    assert!(worst(&sum(&ma, &mb), &mp) < 1e-13);
+    assert!(worst(&sum(&ka, &kb), &kp) < 1e-13);
+
+    let err = patch_matrices(&table, 4, &per[1..])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("one per face"), "{err}");
+    let mut bad = per.clone();
+    bad[5].beta11 = -1.0;
+    let err = patch_matrices(&table, 4, &bad).unwrap_err().to_string();
+    assert!(err.contains("face 5") && err.contains("beta11"), "{err}");
 }

@@ -166,7 +166,7 @@ fn dynamics(mesh: &PolyMesh, drag: &Drag, mu: Real, solver: LinearSolver) -> Sur
     SurfaceDynamics::on_patches(
         drag.engine.table(),
         mesh.positions.clone(),
-        &material(mu),
+        &[material(mu)],
         4,
         0.05,
         solver,

@@ -44,6 +44,70 @@ pub fn patch_stiffness_matrix(
     Ok(k)
 }
 
+/// `[M, D, K]` with a material per base face: the paper's densities and
+/// elasticities `μ(u, v)`, `γ(u, v)`, `α_ii(u, v)`, `β_ij(u, v)` (eqs.
+/// 10–12) taken constant on each face of the control mesh. `materials` holds
+/// one material for the whole surface or one per base face. Every patch's
+/// element is `Σ_q c_q E_q` over the six Jacobian terms `q` with its face's
+/// weights `c`, so the faces' parameters may differ freely; with one
+/// material it equals [`patch_damping_matrix`] and [`patch_stiffness_matrix`].
+pub fn patch_matrices(
+    table: &PatchTable,
+    order: usize,
+    materials: &[MaterialParams],
+) -> Result<[StencilTable; 3]> {
+    let faces = table.num_base_faces();
+    if materials.len() != 1 && materials.len() != faces {
+        return Err(Error::Input(format!(
+            "{} materials for a control mesh of {faces} faces: give one, or one per face",
+            materials.len()
+        )));
+    }
+    for (f, m) in materials.iter().enumerate() {
+        m.check().map_err(|e| match e {
+            Error::Input(what) if materials.len() > 1 => Error::Input(format!("face {f}'s {what}")),
+            e => e,
+        })?;
+    }
+    let unit: [[Real; 6]; 6] = std::array::from_fn(|q| std::array::from_fn(|r| Real::from(q == r)));
+    let terms = elements(table, order, unit)?;
+    let s = table.to_level();
+    let weights: [fn(&MaterialParams) -> [Real; 6]; 3] = [
+        |m| damping_weights(m.mu),
+        |m| damping_weights(m.gamma),
+        stiffness_weights,
+    ];
+    let mut out = Vec::with_capacity(3);
+    for weight in weights {
+        let mut elements = Elements::new();
+        let mut sum = Vec::new();
+        for f in 0..terms.len() {
+            let c = weight(
+                &materials[if materials.len() == 1 {
+                    0
+                } else {
+                    table.base_face(f)
+                }],
+            );
+            let (cols, e) = terms.get(f);
+            sum.clear();
+            sum.resize(e[0].len(), 0.0);
+            for (c, e) in c.iter().zip(e) {
+                if *c != 0.0 {
+                    for (x, y) in sum.iter_mut().zip(e) {
+                        *x += c * y;
+                    }
+                }
+            }
+            elements.push(cols, &sum)?;
+        }
+        out.push(StencilTable::from_elements(s.num_rows(), &elements)?.pulled_back(s)?);
+    }
+    Ok(out
+        .try_into()
+        .unwrap_or_else(|_| unreachable!("three matrices")))
+}
+
 /// `K` of [`patch_stiffness_matrix`] and `D` of [`patch_damping_matrix`]
 /// together, in one pass over the patches (their stencils are shared).
 pub fn patch_stiffness_and_damping(

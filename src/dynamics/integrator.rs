@@ -30,7 +30,7 @@ use crate::math::{Point3, Real};
 use crate::stencil::StencilTable;
 
 use super::cholesky::SparseCholesky;
-use super::elements::{patch_damping_matrix, patch_stiffness_matrix};
+use super::elements::patch_matrices;
 use super::matrices::MaterialParams;
 use super::pcg::{PcgParams, pcg};
 
@@ -137,24 +137,19 @@ impl SurfaceDynamics {
 
     /// [`SurfaceDynamics::new`] with the matrices assembled patch by patch
     /// over `table` (the closest-point engine's patches) with
-    /// Gauss-Legendre `order` × `order` points per polynomial piece:
-    /// `M` from `material.mu` (none when 0), `D` from `material.gamma`, `K`
-    /// from the thin plate's `α` and `β` (all over `du dv`).
+    /// Gauss-Legendre `order` × `order` points per polynomial piece
+    /// ([`patch_matrices`], over `du dv`): `materials` holds one material or
+    /// one per base face; no mass matrix when every `μ` is 0.
     pub fn on_patches(
         table: &PatchTable,
         positions: Vec<Point3>,
-        material: &MaterialParams,
+        materials: &[MaterialParams],
         order: usize,
         dt: Real,
         solver: LinearSolver,
     ) -> Result<SurfaceDynamics> {
-        let mass = if material.mu > 0.0 {
-            Some(patch_damping_matrix(table, order, material.mu)?)
-        } else {
-            None
-        };
-        let damping = patch_damping_matrix(table, order, material.gamma)?;
-        let stiffness = patch_stiffness_matrix(table, order, material)?;
+        let [mass, damping, stiffness] = patch_matrices(table, order, materials)?;
+        let mass = materials.iter().any(|m| m.mu > 0.0).then_some(mass);
         SurfaceDynamics::new(mass, damping, stiffness, positions, dt, solver)
     }
 

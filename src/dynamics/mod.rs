@@ -15,8 +15,8 @@ mod sample_rows;
 
 pub use cholesky::SparseCholesky;
 pub use elements::{
-    PatchElements, parameter_area, patch_damping_matrix, patch_stiffness_and_damping,
-    patch_stiffness_matrix, stiffness_and_damping_elements,
+    PatchElements, parameter_area, patch_damping_matrix, patch_matrices,
+    patch_stiffness_and_damping, patch_stiffness_matrix, stiffness_and_damping_elements,
 };
 pub use integrator::{LinearSolver, StepReport, SurfaceDynamics};
 pub use matrices::{MaterialParams, damping_matrix, mass_matrix, stiffness_matrix};

@@ -336,6 +336,18 @@ impl PatchTable {
         self.patches.len()
     }
 
+    /// Number of faces of the base (control) mesh.
+    pub fn num_base_faces(&self) -> usize {
+        self.offsets
+            .first()
+            .map_or(self.patches.len(), |o| o.len() - 1)
+    }
+
+    /// The base face that patch `f` is a piece of.
+    pub fn base_face(&self, f: usize) -> usize {
+        self.patches[f].base as usize
+    }
+
     /// Connectivity of level `L` (patch `f` is face `f`).
     pub fn level(&self) -> &Level {
         &self.level
