@@ -24,6 +24,13 @@ pub fn bounding_box(points: &[Point3]) -> Option<(Point3, Point3)> {
     Some((lo, hi))
 }
 
+/// The index of the first point with a NaN or infinite coordinate.
+pub fn first_non_finite(points: &[Point3]) -> Option<usize> {
+    points
+        .iter()
+        .position(|p| !p.coords.iter().all(|c| c.is_finite()))
+}
+
 /// Length of the bounding-box diagonal (0 for an empty or single-point set).
 pub fn bbox_diagonal(points: &[Point3]) -> Real {
     bounding_box(points).map_or(0.0, |(lo, hi)| (hi - lo).norm())

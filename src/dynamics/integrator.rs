@@ -26,7 +26,7 @@
 
 use crate::error::{Error, Result};
 use crate::limit::PatchTable;
-use crate::math::{Point3, Real};
+use crate::math::{Point3, Real, first_non_finite};
 use crate::stencil::StencilTable;
 
 use super::cholesky::SparseCholesky;
@@ -109,10 +109,7 @@ impl SurfaceDynamics {
                 "dynamics: time step {dt} must be positive"
             )));
         }
-        if let Some(i) = positions
-            .iter()
-            .position(|p| !p.coords.iter().all(|c| c.is_finite()))
-        {
+        if let Some(i) = first_non_finite(&positions) {
             return Err(Error::Input(format!(
                 "dynamics: control point {i} is not finite"
             )));
@@ -255,10 +252,7 @@ impl SurfaceDynamics {
                 (factor.solve(&rhs)?, 0, !same)
             }
         };
-        if let Some(i) = next
-            .iter()
-            .position(|p| !p.coords.iter().all(|c| c.is_finite()))
-        {
+        if let Some(i) = first_non_finite(&next) {
             return Err(Error::NotConverged(format!(
                 "dynamics: the step gave a non-finite position at control point {i}"
             )));
@@ -281,10 +275,7 @@ impl SurfaceDynamics {
                 load.len()
             )));
         }
-        if let Some(i) = load
-            .iter()
-            .position(|f| !f.coords.iter().all(|c| c.is_finite()))
-        {
+        if let Some(i) = first_non_finite(load) {
             return Err(Error::Input(format!(
                 "dynamics: the load on control point {i} is not finite"
             )));

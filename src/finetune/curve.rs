@@ -39,7 +39,7 @@ use argmin::solver::linesearch::MoreThuenteLineSearch;
 use nalgebra::DVector;
 
 use crate::error::{Error, Result};
-use crate::math::{Point3, Real, Vector3, bounding_box};
+use crate::math::{Point3, Real, Vector3, bounding_box, first_non_finite};
 use crate::subdivision::CurveTopology;
 
 use super::curve_alpha::ScalarFunction;
@@ -147,10 +147,7 @@ impl CurveFinetune {
         params: &CurveFinetuneParams,
     ) -> Result<Self> {
         check_params(params)?;
-        if let Some(i) = points
-            .iter()
-            .position(|p| !p.coords.iter().all(|c| c.is_finite()))
-        {
+        if let Some(i) = first_non_finite(points) {
             return Err(Error::Input(format!("control point {i} is not finite")));
         }
         let exact = exact_finetune(topology, points, alpha)?;

@@ -11,7 +11,7 @@ use super::atomic::atomic_write;
 use super::format::{MeshFormat, is_gzip_path};
 use super::{obj, off, ply, xyz};
 use crate::error::{Error, Result};
-use crate::math::{Point3, Real, Vector3};
+use crate::math::{Point3, Real, Vector3, first_non_finite};
 use crate::mesh::{PointCloud, PolyMesh};
 
 /// What a writer writes: points, optional normals and optional faces.
@@ -83,11 +83,7 @@ pub fn write_mesh(
 pub fn write_points(path: impl AsRef<Path>, cloud: &PointCloud) -> Result<()> {
     let path = path.as_ref();
     let format = MeshFormat::from_path(path)?;
-    if let Some(i) = cloud
-        .positions
-        .iter()
-        .position(|p| !p.coords.iter().all(|c| c.is_finite()))
-    {
+    if let Some(i) = first_non_finite(&cloud.positions) {
         return Err(Error::Input(format!(
             "point {i} has a non-finite coordinate ({}, {}, {})",
             cloud.positions[i].x, cloud.positions[i].y, cloud.positions[i].z

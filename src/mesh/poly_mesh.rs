@@ -1,7 +1,7 @@
 //! `PolyMesh`: positions plus faces of any size in compressed-row form.
 
 use crate::error::{Error, Result};
-use crate::math::Point3;
+use crate::math::{Point3, first_non_finite};
 
 /// A polygon mesh: vertex positions and faces of any size (CSR).
 ///
@@ -101,10 +101,7 @@ impl PolyMesh {
 
 /// Checks that every coordinate is finite; the error names the first bad vertex.
 pub(crate) fn check_finite(points: &[Point3]) -> Result<()> {
-    match points
-        .iter()
-        .position(|p| !p.coords.iter().all(|c| c.is_finite()))
-    {
+    match first_non_finite(points) {
         Some(i) => Err(Error::Input(format!(
             "vertex {i} has a non-finite coordinate ({}, {}, {})",
             points[i].x, points[i].y, points[i].z

@@ -6,7 +6,7 @@
 //! 3×3 symmetric matrix) and are made right-handed, `a_2 = a_0 × a_1`.
 
 use crate::error::{Error, Result};
-use crate::math::{Point3, Real, Vector3};
+use crate::math::{Point3, Real, Vector3, first_non_finite};
 
 /// Fewest points accepted by [`super::initial_mesh`].
 pub const MIN_POINTS: usize = 10;
@@ -135,10 +135,7 @@ pub fn check_points(points: &[Point3]) -> Result<()> {
             "the point cloud is empty; an initial model needs points".into(),
         ));
     }
-    if let Some(i) = points
-        .iter()
-        .position(|p| !p.coords.iter().all(|c| c.is_finite()))
-    {
+    if let Some(i) = first_non_finite(points) {
         let bad = points
             .iter()
             .filter(|p| !p.coords.iter().all(|c| c.is_finite()))
