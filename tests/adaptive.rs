@@ -5,7 +5,7 @@
 mod common;
 
 use common::{Rng, perturbed};
-use subdyn::fit::refine_marks::faces_above_noise;
+use subdyn::fit::refine_marks::{faces_above_noise, faces_off_data};
 use subdyn::limit::{LimitEvaluator, interpolate_limit_points, limit_stencil};
 use subdyn::math::Real;
 use subdyn::mesh::PolyMesh;
@@ -234,4 +234,31 @@ fn the_noise_test_finds_the_biased_face() {
     // Faces with too few points are never split.
     let (marks, _) = faces_above_noise(1, &[0, 0], &[9.0, 9.0], &[1.0, 1.0], 1.0, 0.0);
     assert!(!marks[0]);
+}
+
+/// A web across a gap: surface samples of faces 2 and 5 lie far from the
+/// data, which no data point's residual shows; the off-data test finds
+/// exactly those faces, relative to the median sample distance.
+#[test]
+fn the_off_data_test_finds_webs() {
+    let mut rng = Rng::new(9);
+    let mut face = Vec::new();
+    let mut dist = Vec::new();
+    for f in 0..10u32 {
+        for k in 0..16 {
+            face.push(f);
+            let web = (f == 2 && k == 7) || (f == 5 && k < 4);
+            dist.push(if web { 5.0 } else { rng.uniform(0.5, 1.5) });
+        }
+    }
+    let marks = faces_off_data(10, &face, &dist, 4.0);
+    let marked: Vec<usize> = (0..10).filter(|&f| marks[f]).collect();
+    assert_eq!(marked, vec![2, 5]);
+    // Scaled data, the same faces; a factor above the web's ratio, none.
+    let scaled: Vec<Real> = dist.iter().map(|d| 100.0 * d).collect();
+    assert_eq!(faces_off_data(10, &face, &scaled, 4.0), marks);
+    assert!(!faces_off_data(10, &face, &dist, 6.0).contains(&true));
+    // Off, or nothing to judge by.
+    assert!(!faces_off_data(10, &face, &dist, 0.0).contains(&true));
+    assert!(!faces_off_data(10, &[], &[], 4.0).contains(&true));
 }

@@ -574,6 +574,9 @@ def main() -> int:
     ap.add_argument("--only", nargs="*",
                     help="scan names to run (default: all; `--only` with no name runs none, e.g. with --scaling)")
     ap.add_argument("--out", default=str(HERE), help="where RESULTS.md and RESULTS.json go")
+    ap.add_argument("--seed", type=int, default=1,
+                    help="noise seed of every scan (default 1, the committed results'); another seed shows how "
+                         "much the figures depend on one noise draw (use with --out elsewhere)")
     ap.add_argument("--scaling", action="store_true",
                     help=f"also time subdyn fit on {SCALING_SHAPE} scans of ~10k, 30k, 100k and 1M points")
     ap.add_argument("--scaling-resolutions", nargs="*", default=SCALING_RESOLUTIONS,
@@ -597,11 +600,13 @@ def main() -> int:
         log("`subdyn compare` is not available in this build; cannot measure")
         return 1
 
+    SCAN_ARGS[SCAN_ARGS.index("--seed") + 1] = str(args.seed)
     work = Path(args.work)
     work.mkdir(parents=True, exist_ok=True)
     scans = [s for s in SCANS if args.only is None or s[0] in args.only]
     t_all = time.perf_counter()
-    results = {"machine": machine(), "scans": [], "notes": NOTES, "skipped": []}
+    notes = [n.replace("seed 1,", f"seed {args.seed},") for n in NOTES]
+    results = {"machine": machine(), "scans": [], "notes": notes, "skipped": []}
     for sc in generate_scans(work, scans, results["skipped"]):
         sc["loadavg"] = [round(x, 2) for x in os.getloadavg()]
         sc["run"] = {k: results["machine"][k] for k in ("date", "subdyn_commit")}
@@ -652,6 +657,7 @@ def main() -> int:
         results["scaling"] = run_scaling(work, args.scaling_resolutions)
     results["total_seconds"] = time.perf_counter() - t_all
     out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
     if args.keep:
         keep_previous(results, out / "RESULTS.json")
     write_results(results, out / "RESULTS.md", out / "RESULTS.json")

@@ -41,7 +41,7 @@ use crate::error::{Error, Result};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
-use crate::forces::{PatchAssembly, RobustKernel, RowSprings, robust_weights};
+use crate::forces::{PatchAssembly, RowSprings, robust_weights};
 use crate::limit::{
     ClosestPointEngine, ClosestPointParams, QuadtreeCache, interpolate_limit_points, limit_stencil,
 };
@@ -53,7 +53,7 @@ use crate::subdivision::{
 use crate::topology::face_of_corner;
 
 use super::init::outliers::{Screening, screen};
-use super::refine_marks::faces_above_noise;
+use super::refine_marks::{faces_above_noise, faces_off_data};
 use super::sampling::{shuffled_order, surface_samples, trimmed_rms};
 use super::{ErrorStats, FitParams, FitReport, LevelReport, Refinement};
 
@@ -243,7 +243,7 @@ pub fn fit_screened_cloud(
             .min(per_point.saturating_mul(mesh.num_vertices()))
             .max(4)];
         let n = used.len() as Real;
-        let (used_dist, last_hints) = loop {
+        let (used_dist, last_hints, surface_dist) = loop {
             // Newton from the previous answers every step; every
             // `reseed_every` steps also from the nearest seed, to catch jumps
             // to another part of the surface.
@@ -273,7 +273,7 @@ pub fn fit_screened_cloud(
             // Surface-to-data springs: every surface sample to its nearest
             // data point, so parts of the surface that no data point is
             // closest to (bridges across gaps, flaps) are pulled onto the
-            // data too. Huber weights bound the pull.
+            // data too (`FitParams::surface_robust`).
             let surface = if params.surface_weight > 0.0 {
                 let xs = centres.rows().apply(&p)?;
                 let near: Vec<(Point3, Real)> = xs
@@ -284,7 +284,7 @@ pub fn fit_screened_cloud(
                     })
                     .collect();
                 let dd: Vec<Real> = near.iter().map(|n| n.1).collect();
-                let ws = robust_weights(&dd, RobustKernel::Huber(1.345), 1e-6 * diameter);
+                let ws = robust_weights(&dd, params.surface_robust, 1e-6 * diameter);
                 let m = xs.len() as Real;
                 let ks: Vec<Real> = ws.iter().map(|w| params.surface_weight * w / m).collect();
                 let targets: Vec<Point3> = near.iter().map(|n| n.0).collect();
@@ -319,7 +319,7 @@ pub fn fit_screened_cloud(
             step_rms_pct.push(stats.rms_pct);
             step_p95_pct.push(stats.p95_pct);
             if settled || steps >= params.max_steps {
-                break (dist, hints);
+                break (dist, hints, surface.map(|s| s.3));
             }
             let springs = assembly.data_springs(
                 engine.table(),
@@ -486,7 +486,7 @@ pub fn fit_screened_cloud(
                     .zip(&keep)
                     .map(|(&w, &k)| if k { w } else { 0.0 })
                     .collect();
-                let (marks, _) = faces_above_noise(
+                let (mut marks, _) = faces_above_noise(
                     mesh.num_faces(),
                     &face,
                     &dist,
@@ -494,6 +494,24 @@ pub fn fit_screened_cloud(
                     data_noise,
                     params.refine_significance,
                 );
+                // Webs across gaps in the data: surface samples far off it.
+                let per_patch = params.surface_samples * params.surface_samples;
+                let sample_face: Vec<u32> = (0..surface_dist.as_ref().map_or(0, Vec::len))
+                    .map(|i| face_of_patch[i / per_patch])
+                    .collect();
+                let off_data = faces_off_data(
+                    mesh.num_faces(),
+                    &sample_face,
+                    surface_dist.as_deref().unwrap_or_default(),
+                    params.refine_off_data,
+                );
+                let mut webs = 0;
+                for (m, &off) in marks.iter_mut().zip(&off_data) {
+                    if off && !*m {
+                        *m = true;
+                        webs += 1;
+                    }
+                }
                 if !marks.contains(&true) {
                     break (
                         false,
@@ -505,9 +523,14 @@ pub fn fit_screened_cloud(
                 let marks = close_marks(h.level(0), &marks);
                 let local = locally_refined(&mesh, &h, &marks)?;
                 refinement = format!(
-                    "adaptive: {} of {} faces split",
+                    "adaptive: {} of {} faces split{}",
                     marks.iter().filter(|&&m| m).count(),
-                    marks.len()
+                    marks.len(),
+                    if webs > 0 {
+                        format!(" ({webs} with surface samples off the data)")
+                    } else {
+                        String::new()
+                    }
                 );
                 adaptive_parent = Some(mesh.clone());
                 carried_hints = Some(

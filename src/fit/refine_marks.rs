@@ -1,6 +1,7 @@
 //! Which control faces to refine: those whose data residual is above the
 //! noise (the test behind adaptive refinement in
-//! [`Refinement::Adaptive`](super::Refinement)).
+//! [`Refinement::Adaptive`](super::Refinement)), and those with a surface
+//! sample far off the data ([`faces_off_data`]).
 //!
 //! With Gaussian noise of deviation `σ` along the normal, the squared
 //! distances of a face's `n` points to a surface that has no bias there
@@ -57,4 +58,28 @@ pub fn faces_above_noise(
         })
         .collect();
     (marks, sigma)
+}
+
+/// The faces holding a surface sample whose distance to its nearest data
+/// point exceeds `factor` times the median of those distances: parts of the
+/// surface spanning a gap in the data (a web across a slot the scan did not
+/// see into). No data point is closest to such a face, so
+/// [`faces_above_noise`] never splits it. The median measures the data's
+/// spacing and noise, which every sample of a surface that follows the data
+/// is within. `face[i]` is the control face of sample `i`; `factor` ≤ 0
+/// marks nothing.
+pub fn faces_off_data(num_faces: usize, face: &[u32], dist: &[Real], factor: Real) -> Vec<bool> {
+    let mut marks = vec![false; num_faces];
+    let mut finite: Vec<Real> = dist.iter().copied().filter(|d| d.is_finite()).collect();
+    if factor <= 0.0 || finite.is_empty() {
+        return marks;
+    }
+    let mid = finite.len() / 2;
+    let limit = factor * *finite.select_nth_unstable_by(mid, Real::total_cmp).1;
+    for (&f, &d) in face.iter().zip(dist) {
+        if d > limit {
+            marks[f as usize] = true;
+        }
+    }
+    marks
 }
