@@ -885,6 +885,16 @@ fn fit_bad_inputs_are_one_line_errors() {
         &["tol"],
         &["nan.xyz", "sphere.xyz", "three.xyz"],
     );
+    let out = run_subdyn(
+        dir.path(),
+        &["fit", "sphere.xyz", "-o", "fit.obj", "--refine-off-data=-1"],
+    );
+    assert_clean_failure(
+        dir.path(),
+        &out,
+        &["refine_off_data"],
+        &["nan.xyz", "sphere.xyz", "three.xyz"],
+    );
     // A missing output directory is reported before any work.
     for args in [
         ["-o", "missing/fit.obj", "--report", "r.json"],

@@ -76,6 +76,11 @@ pub struct FitArgs {
     /// exceeds the noise variance by Z standard errors; lower splits more.
     #[arg(long, value_name = "Z", default_value_t = FitParams::default().refine_significance)]
     pub refine_significance: f64,
+    /// Adaptive refinement also splits a face when one of its surface samples
+    /// is farther from the data than F times the median such distance (a web
+    /// across a gap the scan did not see into); 0 turns this off.
+    #[arg(long, value_name = "F", default_value_t = FitParams::default().refine_off_data)]
+    pub refine_off_data: f64,
     /// Tension weight λ_t of the thin plate (α = λ_t / area).
     #[arg(long, value_name = "λ", default_value_t = FitParams::default().tension)]
     pub tension: f64,
@@ -139,6 +144,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             RefineMode::Uniform => Refinement::Uniform,
         },
         refine_significance: args.refine_significance,
+        refine_off_data: args.refine_off_data,
         tension: args.tension,
         bending: args.bending,
         mass: args.mass,
