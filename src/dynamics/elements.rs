@@ -63,9 +63,10 @@ pub fn patch_matrices(
             materials.len()
         )));
     }
+    let uniform = materials.len() == 1;
     for (f, m) in materials.iter().enumerate() {
         m.check().map_err(|e| match e {
-            Error::Input(what) if materials.len() > 1 => Error::Input(format!("face {f}'s {what}")),
+            Error::Input(what) if !uniform => Error::Input(format!("face {f}'s {what}")),
             e => e,
         })?;
     }
@@ -82,13 +83,7 @@ pub fn patch_matrices(
         let mut elements = Elements::new();
         let mut sum = Vec::new();
         for f in 0..terms.len() {
-            let c = weight(
-                &materials[if materials.len() == 1 {
-                    0
-                } else {
-                    table.base_face(f)
-                }],
-            );
+            let c = weight(&materials[if uniform { 0 } else { table.base_face(f) }]);
             let (cols, e) = terms.get(f);
             sum.clear();
             sum.resize(e[0].len(), 0.0);
