@@ -289,12 +289,7 @@ fn regular_patches_agree_with_brute_force_quadrature() {
 
 /// The cube refined twice, perturbed.
 fn refined_cube() -> PolyMesh {
-    let mut mesh = subdyn::examples::cube();
-    for _ in 0..2 {
-        let h = default_refiner(&mesh).refine_uniform(1).unwrap();
-        let p = h.stencil(0).apply(&mesh.positions).unwrap();
-        mesh = h.mesh(1, p);
-    }
+    let mut mesh = common::refined_cube(2);
     let mut seed = 3;
     for p in &mut mesh.positions {
         p.x += 0.02 * lcg(&mut seed);

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{default_refiner, mixed_mesh};
+use common::{default_refiner, mixed_mesh, refined_cube};
 use subdyn::dynamics::{
     LinearSolver, MaterialParams, PcgParams, SparseCholesky, SurfaceDynamics, patch_damping_matrix,
     patch_stiffness_matrix, pcg,
@@ -13,17 +13,6 @@ use subdyn::limit::{ClosestPoint, ClosestPointEngine, ClosestPointParams};
 use subdyn::math::{Point3, Real, Vector3};
 use subdyn::mesh::PolyMesh;
 use subdyn::stencil::StencilTable;
-
-/// The cube refined twice (98 control points, 8 of valence 3).
-fn refined_cube() -> PolyMesh {
-    let mut mesh = subdyn::examples::cube();
-    for _ in 0..2 {
-        let h = default_refiner(&mesh).refine_uniform(1).unwrap();
-        let p = h.stencil(0).apply(&mesh.positions).unwrap();
-        mesh = h.mesh(1, p);
-    }
-    mesh
-}
 
 fn engine(mesh: &PolyMesh) -> ClosestPointEngine {
     ClosestPointEngine::new(
@@ -82,7 +71,7 @@ fn worst(a: &[Point3], b: &[Point3]) -> Real {
 /// triangles, quads and a pentagon with a boundary.
 #[test]
 fn cholesky_solves_step_systems() {
-    for (name, mesh) in [("cube", refined_cube()), ("mixed", mixed_mesh())] {
+    for (name, mesh) in [("cube", refined_cube(2)), ("mixed", mixed_mesh())] {
         let a = step_matrix(&mesh, Point3::new(0.9, 0.2, 0.1));
         let n = a.num_rows();
         let b = right_hand_sides(n);
@@ -113,7 +102,7 @@ fn cholesky_solves_step_systems() {
 /// another; an indefinite matrix is an error and keeps the previous factor.
 #[test]
 fn cholesky_refactors_and_rejects_indefinite_matrices() {
-    let mesh = refined_cube();
+    let mesh = refined_cube(2);
     let a = step_matrix(&mesh, Point3::new(0.9, 0.2, 0.1));
     let b = right_hand_sides(a.num_rows());
     let mut factor = SparseCholesky::new(&a).unwrap();
@@ -184,7 +173,7 @@ const PCG: LinearSolver = LinearSolver::Pcg(PcgParams {
 /// spring attachment, not once per step.
 #[test]
 fn massless_steps_dissipate_and_reuse_the_factor() {
-    let mesh = refined_cube();
+    let mesh = refined_cube(2);
     let drag = Drag::new(&mesh, Point3::new(0.9, 0.3, 0.2));
     let mut chol = dynamics(&mesh, &drag, 0.0, LinearSolver::Cholesky);
     let mut cg = dynamics(&mesh, &drag, 0.0, PCG);
@@ -242,7 +231,7 @@ fn massless_steps_dissipate_and_reuse_the_factor() {
 /// massless surface by less than a tenth.
 #[test]
 fn second_order_steps_dissipate_and_overshoot() {
-    let mesh = refined_cube();
+    let mesh = refined_cube(2);
     let drag = Drag::new(&mesh, Point3::new(0.9, 0.3, 0.2));
     let (s, f) = drag.spring(Vector3::new(0.3, 0.0, 0.0));
     let probe = |d: &SurfaceDynamics| {
@@ -295,7 +284,7 @@ fn second_order_steps_dissipate_and_overshoot() {
 
 #[test]
 fn bad_dynamics_input_is_an_error() {
-    let mesh = refined_cube();
+    let mesh = refined_cube(2);
     let drag = Drag::new(&mesh, Point3::new(0.9, 0.3, 0.2));
     let e = drag.engine.table();
     let m = material(0.0);

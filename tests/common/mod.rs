@@ -342,6 +342,18 @@ pub fn default_refiner(mesh: &PolyMesh) -> Refiner {
     refiner(mesh, BoundaryRule::EdgeAndCorner, &[])
 }
 
+/// The cube refined `times` times uniformly (twice: 98 control points, 8 of
+/// valence 3).
+pub fn refined_cube(times: usize) -> PolyMesh {
+    let mut mesh = subdyn::examples::cube();
+    for _ in 0..times {
+        let h = default_refiner(&mesh).refine_uniform(1).unwrap();
+        let p = h.stencil(0).apply(&mesh.positions).unwrap();
+        mesh = h.mesh(1, p);
+    }
+    mesh
+}
+
 /// Index at level `k` of the vertex point descending from level-0 vertex `v`
 /// (vertex points come after face and edge points at every level).
 pub fn descendant(h: &Hierarchy, k: usize, v: usize) -> usize {
