@@ -90,19 +90,12 @@ impl SurfaceDynamics {
         solver: LinearSolver,
     ) -> Result<SurfaceDynamics> {
         let n = positions.len();
-        for (name, m) in [("damping", Some(&damping)), ("stiffness", Some(&stiffness))]
-            .into_iter()
-            .chain([("mass", mass.as_ref())])
-        {
-            if let Some(m) = m
-                && (m.num_rows() != n || m.num_cols != n)
-            {
-                return Err(Error::Input(format!(
-                    "dynamics: the {name} matrix is {} × {} for {n} control points",
-                    m.num_rows(),
-                    m.num_cols
-                )));
-            }
+        for (name, m) in [
+            ("damping", Some(&damping)),
+            ("stiffness", Some(&stiffness)),
+            ("mass", mass.as_ref()),
+        ] {
+            check_size(name, m, n)?;
         }
         if !(dt > 0.0 && dt.is_finite()) {
             return Err(Error::Input(format!(
@@ -280,15 +273,18 @@ impl SurfaceDynamics {
                 "dynamics: the load on control point {i} is not finite"
             )));
         }
-        if let Some(s) = springs
-            && (s.num_rows() != n || s.num_cols != n)
-        {
-            return Err(Error::Input(format!(
-                "dynamics: a spring matrix of {} × {} for {n} control points",
-                s.num_rows(),
-                s.num_cols
-            )));
-        }
-        Ok(())
+        check_size("spring", springs, n)
+    }
+}
+
+/// An error unless `m` (when given) is `n × n`.
+fn check_size(name: &str, m: Option<&StencilTable>, n: usize) -> Result<()> {
+    match m {
+        Some(m) if m.num_rows() != n || m.num_cols != n => Err(Error::Input(format!(
+            "dynamics: the {name} matrix is {} × {} for {n} control points",
+            m.num_rows(),
+            m.num_cols
+        ))),
+        _ => Ok(()),
     }
 }
