@@ -53,6 +53,9 @@ fn every_shape_is_closed_with_the_right_euler_characteristic() {
         ("genus2", -2),
         ("bulb", 2),
         ("anvil", 2),
+        ("plate", 0),
+        ("bracket", -6),
+        ("chair", -8),
     ] {
         let out = format!("{name}.obj");
         ok(&dir, &["shape", name, "-o", &out]);

@@ -7,7 +7,7 @@ use subdyn::math::{Point3, Real};
 use subdyn::mesh::PolyMesh;
 
 use super::sdf::Field;
-use super::{anvil, bulb, genus2, quad_sphere};
+use super::{anvil, bulb, genus2, machined, quad_sphere};
 use crate::measure::orient_outward;
 use crate::topology::mesh_topology;
 
@@ -26,6 +26,12 @@ pub enum ShapeKind {
     Bulb,
     /// Rounded boxes with a conical horn, blended (marching tetrahedra), genus 0.
     Anvil,
+    /// A thin plate with a through slot, sharp edges (exact box mesh), genus 1.
+    Plate,
+    /// An L-bracket with two holes and a slot in its base and a hole in its flange, sharp edges, genus 4.
+    Bracket,
+    /// A chair with thin square legs and a slatted back (narrow gaps), sharp edges, genus 5.
+    Chair,
 }
 
 impl ShapeKind {
@@ -38,6 +44,9 @@ impl ShapeKind {
             ShapeKind::Genus2 => "genus2",
             ShapeKind::Bulb => "bulb",
             ShapeKind::Anvil => "anvil",
+            ShapeKind::Plate => "plate",
+            ShapeKind::Bracket => "bracket",
+            ShapeKind::Chair => "chair",
         }
     }
 
@@ -50,14 +59,18 @@ impl ShapeKind {
             ShapeKind::Bulb => (128, 3, 4096),
             ShapeKind::Genus2 => (110, 16, 1000),
             ShapeKind::Anvil => (110, 16, 1000),
+            ShapeKind::Plate | ShapeKind::Chair => (100, 10, 1000),
+            ShapeKind::Bracket => (90, 10, 1000),
         }
     }
 
     /// The expected genus.
     pub fn genus(self) -> i64 {
         match self {
-            ShapeKind::Torus => 1,
+            ShapeKind::Torus | ShapeKind::Plate => 1,
             ShapeKind::Genus2 => 2,
+            ShapeKind::Bracket => 4,
+            ShapeKind::Chair => 5,
             _ => 0,
         }
     }
@@ -213,6 +226,23 @@ pub fn build_shape(kind: ShapeKind, params: &ShapeParams) -> Result<Shape> {
                 "implicit": anvil::FORMULA,
             }),
         ),
+        ShapeKind::Plate | ShapeKind::Bracket | ShapeKind::Chair => {
+            let (solid, mesh) = match kind {
+                ShapeKind::Plate => (&machined::PLATE, machined::plate(n)?),
+                ShapeKind::Bracket => (&machined::BRACKET, machined::bracket(n)?),
+                _ => (&machined::CHAIR, machined::chair(n)?),
+            };
+            (
+                mesh,
+                Box::new(|p: &Point3| solid.field(p)) as Box<Field>,
+                json!({
+                    "resolution": n,
+                    "resolution_meaning": "grid steps along the longest side (box corners are grid lines)",
+                    "implicit": machined::formula(solid),
+                    "sharp_edges": true,
+                }),
+            )
+        }
     };
     orient_outward(&mut mesh);
     let topology = mesh_topology(&mesh);

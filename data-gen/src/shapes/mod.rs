@@ -3,8 +3,10 @@
 mod anvil;
 mod bulb;
 mod catalog;
+mod cuboids;
 mod genus2;
 mod implicit;
+mod machined;
 mod marching_tets;
 mod quad_sphere;
 mod relax;
