@@ -583,7 +583,25 @@ def main() -> int:
                     help="pixels per view W,H of the scaling scans (8 views)")
     ap.add_argument("--keep", action="store_true",
                     help="keep the scans (and the scaling table) of the previous RESULTS.json that this run does not redo")
+    ap.add_argument("--corpus", action="store_true",
+                    help="the corpus benchmark instead of the four scans: every corpus shape fitted by subdyn, "
+                         "Open3D Poisson depth 8 and pymeshlab, one table with the issue-24 criteria (README.md, Corpus)")
+    ap.add_argument("--scans-only", action="store_true", help="with --corpus: write the corpus inputs and stop")
+    ap.add_argument("--subdyn-only", action="store_true",
+                    help="with --corpus: refit subdyn only, reusing each row's Poisson/pymeshlab figures from the "
+                         "last run that made them (marked cached)")
+    ap.add_argument("--shapes", metavar="A,B,C",
+                    help="with --corpus: only these rows (row names like cow-n1 or shape names like cow); "
+                         "RESULTS.* stay untouched, the table goes to WORK/corpus/last_table.md")
+    ap.add_argument("--split", choices=["choose", "check"],
+                    help="with --corpus: only the rows of this set (choose: defaults may be tuned on it; check: held out)")
+    ap.add_argument("--baseline", action="store_true",
+                    help="with --corpus: write the section 'Corpus baseline (before issue 24 work)' instead of "
+                         "'Corpus benchmark'")
     args = ap.parse_args()
+    corpus_only = [a for a in ("scans_only", "subdyn_only", "shapes", "split", "baseline") if getattr(args, a)]
+    if corpus_only and not args.corpus:
+        ap.error("--" + corpus_only[0].replace("_", "-") + " needs --corpus")
 
     # OpenMP threads that busy-wait (libgomp's default) starve each other and
     # the other processes on a small shared machine: pymeshlab's screened
@@ -600,6 +618,12 @@ def main() -> int:
         log("`subdyn compare` is not available in this build; cannot measure")
         return 1
 
+    if args.corpus:
+        import corpus
+
+        args.section = "Corpus baseline (before issue 24 work)" if args.baseline else "Corpus benchmark"
+        args.section_key = "corpus_baseline" if args.baseline else "corpus"
+        return corpus.main(args)
     SCAN_ARGS[SCAN_ARGS.index("--seed") + 1] = str(args.seed)
     work = Path(args.work)
     work.mkdir(parents=True, exist_ok=True)
