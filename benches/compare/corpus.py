@@ -276,13 +276,13 @@ def single_view_p95(surface: Path, scan_xyz: Path) -> dict:
         pos, polys = read_mesh_faces(surface)
         mesh = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(pos),
                                          o3d.utility.Vector3iVector(triangles(pos, polys)))
-    scene = o3d.t.geometry.RaycastingScene()
-    scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(mesh))
-    d_scan = scene.compute_distance(o3d.core.Tensor(pts.astype(np.float32))).numpy()
+    # Scan → surface with subdyn's exact point-to-triangle distances (B = the surface; rescaled to the scan's diagonal).
+    rep = rc.compare(scan_xyz, surface, surface.with_name(surface.stem + "_scan_compare.json"))
+    scan_to_surface = float(rep["a_to_b"]["stats_pct"]["p95"]) * float(rep["diagonal"]) / diag
     samples = mesh.sample_points_uniformly(100_000)
     cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(pts))
     d_surf = np.asarray(samples.compute_point_cloud_distance(cloud))
-    return {"scan_to_surface_p95_pct": 100 * float(np.percentile(d_scan, 95)) / diag,
+    return {"scan_to_surface_p95_pct": scan_to_surface,
             "surface_to_scan_p95_pct": 100 * float(np.percentile(d_surf, 95)) / diag,
             "scan_diagonal": diag}
 
