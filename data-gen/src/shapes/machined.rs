@@ -119,10 +119,10 @@ mod tests {
         for f in mesh.faces() {
             for i in 0..f.len() {
                 let (a, b) = (f[i], f[(i + 1) % f.len()]);
-                if let Some(m) = by_edge.insert((a.min(b), a.max(b)), normal(f)) {
-                    if m.dot(&normal(f)).abs() < 1e-12 {
-                        right += 1;
-                    }
+                if let Some(m) = by_edge.insert((a.min(b), a.max(b)), normal(f))
+                    && m.dot(&normal(f)).abs() < 1e-12
+                {
+                    right += 1;
                 }
             }
         }
