@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 use serde_json::Value;
+use subdyn::math::{Point3, Vector3};
 
 fn stdout(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
@@ -531,7 +532,7 @@ fn limit_of_closed_cube_is_watertight_with_normals() {
     ));
     assert!(out.contains("t.ply"), "{out}");
     let info = info_json(dir.path(), "t.ply");
-    assert_eq!(info["faces"], 6 * 9);
+    assert_eq!(info["faces"], 6 * 9 * 2, "triangles by default");
     assert_eq!(info["boundary_edges"], 0, "watertight");
     assert_eq!(info["genus"], 0);
     assert_eq!(info["normals"], true);
@@ -545,6 +546,61 @@ fn limit_of_closed_cube_is_watertight_with_normals() {
         &["--tess 0"],
         &["cube.obj", "r.json", "t.ply"],
     );
+}
+
+#[test]
+fn limit_surfaces_are_triangles_unless_quads_is_given() {
+    let dir = tempfile::tempdir().unwrap();
+    copy(dir.path(), "opensubdiv/cube.obj", "cube.obj");
+    let limit = |out: &str, extra: &[&str]| {
+        ok(&run_subdyn(
+            dir.path(),
+            &[&["limit", "cube.obj", "-o", out, "--tess", "3"], extra].concat(),
+        ));
+    };
+    limit("t.off", &[]);
+    limit("q.off", &["--quads"]);
+    let (t, q) = (read_out(dir.path(), "t.off"), read_out(dir.path(), "q.off"));
+    assert!(t.faces().all(|f| f.len() == 3));
+    assert!(q.faces().all(|f| f.len() == 4));
+    assert_eq!((t.num_faces(), q.num_faces()), (6 * 9 * 2, 6 * 9));
+    assert_eq!(t.positions, q.positions, "the same samples either way");
+    // Each quad's two triangles face the same way: every triangle normal
+    // points away from the cube's centre (the limit surface is convex).
+    let c = Point3::new(0.0, 0.0, 0.0)
+        + t.positions.iter().map(|p| p.coords).sum::<Vector3>() / t.positions.len() as f64;
+    for f in t.faces() {
+        let [a, b, d] = [0, 1, 2].map(|i| t.positions[f[i] as usize]);
+        assert!(
+            (b - a).cross(&(d - a)).dot(&(a - c)) > 0.0,
+            "{f:?} faces inwards"
+        );
+    }
+    let sub = |out: &str, extra: &[&str]| {
+        run_subdyn(
+            dir.path(),
+            &[
+                &["subdivide", "cube.obj", "-o", out, "--levels", "2"],
+                extra,
+            ]
+            .concat(),
+        )
+    };
+    ok(&sub("lt.obj", &["--limit"]));
+    ok(&sub("lq.obj", &["--limit", "--quads"]));
+    ok(&sub("r.obj", &[]));
+    assert!(read_out(dir.path(), "lt.obj").faces().all(|f| f.len() == 3));
+    assert!(read_out(dir.path(), "lq.obj").faces().all(|f| f.len() == 4));
+    assert!(
+        read_out(dir.path(), "r.obj").faces().all(|f| f.len() == 4),
+        "a control mesh stays quads"
+    );
+    let out = sub("x.obj", &["--quads"]);
+    assert_eq!(out.status.code(), Some(2), "--quads needs --limit");
+}
+
+fn read_out(dir: &Path, name: &str) -> subdyn::mesh::PolyMesh {
+    subdyn::io::read_mesh(dir.join(name)).unwrap()
 }
 
 // ---------------------------------------------------------------- info

@@ -8,17 +8,15 @@ use clap::{Args, ValueEnum};
 use serde_json::json;
 
 use subdyn::fit::init::InitParams;
-use subdyn::fit::init::outliers::Screening;
-use subdyn::fit::{FitParams, FitReport, Refinement, ToleranceStat, fit_screened_cloud};
+use subdyn::fit::{FitParams, FitReport, FitStart, Refinement, ToleranceStat, fit_from_start};
 use subdyn::io::{read_points, write_mesh};
 use subdyn::limit::tessellate;
-use subdyn::mesh::{PointCloud, PolyMesh};
 use subdyn::subdivision::{RefineOptions, Refiner};
 
 use super::common::{
     about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, write_report,
 };
-use super::options::read_polygon_mesh;
+use super::options::{LimitFacesArgs, read_polygon_mesh};
 use super::progress::Progress;
 
 /// Which statistic `--tol` applies to.
@@ -102,6 +100,8 @@ pub struct FitArgs {
     /// Tessellation rate of --limit-out.
     #[arg(long, value_name = "K", default_value_t = 4)]
     pub tess: usize,
+    #[command(flatten)]
+    pub faces: LimitFacesArgs,
     /// Write a JSON report (per level: control points, time, CG iterations, errors).
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
@@ -163,44 +163,41 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             "the embedded demo scan".to_string(),
         ),
     };
-    check_cloud(&cloud, &name)?;
     progress.stage("building the initial model");
-    let (init, init_report, screening) =
-        initial_model(&args.init, args.init_resolution, &cloud, args.quiet)?;
+    let start_mesh = fit_start(&args.init, args.init_resolution, args.quiet)?;
     let mut fit_progress = |level: usize, step: usize, energy: f64| {
         progress.stage(format!("level {level}, step {step}: energy {energy:.4e}"));
     };
-    let result = fit_screened_cloud(
-        &cloud,
-        screening.as_ref(),
-        &init,
-        &params,
-        &mut fit_progress,
-    )
-    .map_err(|e| anyhow::Error::new(e).context(format!("fitting {name}")))?;
+    let mut run = fit_from_start(&cloud, &start_mesh, &params, &mut fit_progress)
+        .map_err(|e| anyhow::Error::new(e).context(format!("fitting {name}")))?;
+    if matches!(start_mesh, FitStart::Mesh(_)) {
+        run.init_report["method"] = json!("file");
+        run.init_report["path"] = json!(args.init);
+    }
+    let result = &run.result;
     progress.stage(format!("writing {}", args.output.display()));
     write_mesh(&args.output, &result.control, None).map_err(|e| about_file(e, &args.output))?;
     if let Some(path) = &args.limit_out {
         let refiner = Refiner::new(&result.control, &RefineOptions::default())?;
         let (surf, normals) = tessellate(&refiner, &result.control.positions, args.tess)?;
-        write_mesh(path, &surf, Some(&normals)).map_err(|e| about_file(e, path))?;
+        write_mesh(path, &args.faces.mesh(&surf), Some(&normals))
+            .map_err(|e| about_file(e, path))?;
     }
     if let Some(path) = &args.plot {
         write_plot(path, &result.report)?;
     }
     drop(progress);
     if let Some(path) = &args.report {
-        let value = json!({
+        let mut value = json!({
             "command": "fit",
             "input": name,
             "output": args.output.display().to_string(),
             "limit_out": args.limit_out.as_ref().map(|p| p.display().to_string()),
-            "init": init_report,
-            "tolerance_pct": args.tol,
-            "tolerance_stat": format!("{:?}", args.tol_stat).to_lowercase(),
-            "fit": serde_json::to_value(&result.report)?,
-            "total_s": seconds(start),
         });
+        if let Some(map) = value.as_object_mut() {
+            map.extend(run.report(&params)?);
+            map.insert("total_s".into(), json!(seconds(start)));
+        }
         write_report(path, &value)?;
     }
     print_stdout(&summary(
@@ -249,45 +246,20 @@ fn write_plot(path: &Path, report: &FitReport) -> anyhow::Result<()> {
     write_png(path, &pic).map_err(|e| about_file(e, path))
 }
 
-fn check_cloud(cloud: &PointCloud, name: &str) -> anyhow::Result<()> {
-    if cloud.len() < 10 {
-        anyhow::bail!(
-            "{name}: {} points; a fit needs at least 10 points spread over the surface",
-            cloud.len()
-        );
-    }
-    Ok(())
-}
-
-/// The initial control mesh: a file, or `auto` (with the cloud's outlier
-/// screening, for the fit to reuse).
-fn initial_model(
-    init: &str,
-    resolution: usize,
-    cloud: &PointCloud,
-    quiet: bool,
-) -> anyhow::Result<(PolyMesh, serde_json::Value, Option<Screening>)> {
+/// Where the fit starts: a method name (`auto`, …), or a mesh file, read
+/// and checked to be subdividable here so that its errors name the file.
+fn fit_start(init: &str, resolution: usize, quiet: bool) -> anyhow::Result<FitStart> {
     if let Ok(kind) = init.parse::<subdyn::fit::init::InitKind>() {
-        let params = InitParams {
+        return Ok(FitStart::Method(InitParams {
             kind,
             resolution,
             ..Default::default()
-        };
-        let (mesh, report) = subdyn::fit::init::initial_mesh(cloud, &params)?;
-        let value = json!({
-            "method": format!("{:?}", report.chosen).to_lowercase(),
-            "reason": report.reason,
-            "genus": report.genus,
-            "vertices": mesh.num_vertices(),
-            "faces": mesh.num_faces(),
-        });
-        return Ok((mesh, value, report.screening));
+        }));
     }
     let path = Path::new(init);
     let mesh = read_polygon_mesh(path, quiet)?;
     Refiner::new(&mesh, &RefineOptions::default()).map_err(|e| about_file(e, path))?;
-    let value = json!({"method": "file", "path": init, "vertices": mesh.num_vertices(), "faces": mesh.num_faces()});
-    Ok((mesh, value, None))
+    Ok(FitStart::Mesh(mesh))
 }
 
 fn summary(name: &str, output: &Path, limit: Option<&Path>, r: &FitReport) -> String {

@@ -12,7 +12,7 @@ use subdyn::limit::tessellate;
 use super::common::{
     about_file, bbox_json, check_mesh_output, print_stdout, seconds, thousands, timed, write_report,
 };
-use super::options::{RefineArgs, read_polygon_mesh};
+use super::options::{LimitFacesArgs, RefineArgs, read_polygon_mesh};
 use super::progress::Progress;
 use super::subdivide::MAX_FACES;
 
@@ -29,7 +29,8 @@ pub struct LimitArgs {
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Samples per quad edge: each quad (each quad sub-face of an n-gon)
-    /// becomes a K×K grid of quads whose vertices lie on the limit surface.
+    /// becomes a K×K grid of quads (2 K² triangles) whose vertices lie on the
+    /// limit surface.
     #[arg(short = 'k', long = "tess", value_name = "K", default_value_t = 4)]
     pub tess: usize,
     /// Also write the limit-surface unit normal of every output vertex.
@@ -37,6 +38,8 @@ pub struct LimitArgs {
     pub normals: bool,
     #[command(flatten)]
     pub refine: RefineArgs,
+    #[command(flatten)]
+    pub faces: LimitFacesArgs,
     /// Write a JSON report (counts, timings, bounding box).
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
@@ -84,6 +87,7 @@ pub fn run(args: &LimitArgs) -> anyhow::Result<()> {
     ));
     let (tess, tess_s) = timed(|| tessellate(&refiner, &mesh.positions, args.tess));
     let (out, normals) = tess.map_err(|e| about_file(e, &args.input))?;
+    let out = args.faces.mesh(&out);
 
     progress.stage(format!("writing {}", args.output.display()));
     let normals = args.normals.then_some(normals.as_slice());
@@ -98,6 +102,7 @@ pub fn run(args: &LimitArgs) -> anyhow::Result<()> {
             "output": args.output.display().to_string(),
             "tess": args.tess,
             "normals": args.normals,
+            "quads": args.faces.quads,
             "boundary": args.refine.boundary.name(),
             "creases": refiner.options.creases.len(),
             "control": {"vertices": mesh.num_vertices(), "faces": mesh.num_faces()},

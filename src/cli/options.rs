@@ -1,6 +1,7 @@
 //! Options shared by the verbs that refine a mesh: boundary rule and creases,
 //! and the loading of the input mesh.
 
+use std::borrow::Cow;
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
@@ -106,5 +107,27 @@ pub fn warn_isolated(mesh: &PolyMesh, name: &str, quiet: bool) {
                 thousands(isolated.len())
             ),
         );
+    }
+}
+
+/// `--quads` of the verbs that write a tessellated limit surface.
+#[derive(Clone, Copy, Debug, Args)]
+pub struct LimitFacesArgs {
+    /// Write the limit surface as quads (default: triangles, each quad split
+    /// along the diagonal whose two triangles face the same way best, which
+    /// every mesh tool reads).
+    #[arg(long)]
+    pub quads: bool,
+}
+
+impl LimitFacesArgs {
+    /// The faces to write for a quad tessellation: itself with `--quads`,
+    /// else its triangles ([`subdyn::mesh::split_quads`]).
+    pub fn mesh(self, tessellation: &PolyMesh) -> Cow<'_, PolyMesh> {
+        if self.quads {
+            Cow::Borrowed(tessellation)
+        } else {
+            Cow::Owned(subdyn::mesh::split_quads(tessellation))
+        }
     }
 }

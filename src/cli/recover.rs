@@ -23,7 +23,7 @@ use super::common::{
     about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, write_report,
 };
 use super::memory::{StagePeaks, peak_rss, stage_peak};
-use super::options::read_polygon_mesh;
+use super::options::{LimitFacesArgs, read_polygon_mesh};
 use super::progress::Progress;
 
 /// Arguments of `subdyn recover`.
@@ -98,6 +98,8 @@ pub struct RecoverArgs {
     /// Tessellation rate of --limit-out and of the slice contours.
     #[arg(long, value_name = "K", default_value_t = 4)]
     pub tess: usize,
+    #[command(flatten)]
+    pub faces: LimitFacesArgs,
     /// Write a JSON report (stage times, per level: control points, steps, offsets).
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
@@ -212,7 +214,8 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     };
     let (surf, normals) = surface(&result.control)?;
     if let Some(path) = &args.limit_out {
-        write_mesh(path, &surf, Some(&normals)).map_err(|e| about_file(e, path))?;
+        write_mesh(path, &args.faces.mesh(&surf), Some(&normals))
+            .map_err(|e| about_file(e, path))?;
     }
     let mut slice_files = Vec::new();
     if let Some(dir) = &args.slices_png {

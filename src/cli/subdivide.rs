@@ -35,9 +35,15 @@ pub struct SubdivideArgs {
     /// Number of uniform refinement levels (0 to 8).
     #[arg(short, long, default_value_t = 2)]
     pub levels: usize,
-    /// Move every output vertex to its position on the limit surface (Catmull-Clark only).
+    /// Move every output vertex to its position on the limit surface
+    /// (Catmull-Clark only); the faces are then written as triangles (see
+    /// --quads).
     #[arg(long)]
     pub limit: bool,
+    /// With --limit, keep the quads (default: triangles, each quad split
+    /// along the diagonal whose two triangles face the same way best).
+    #[arg(long, requires = "limit")]
+    pub quads: bool,
     /// Subdivision scheme.
     #[arg(long, value_enum, default_value_t = Scheme::CatmullClark)]
     pub scheme: Scheme,
@@ -91,6 +97,11 @@ pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
     let positions = positions?;
     let bbox = bbox_json(&positions);
     let out = hierarchy.mesh(args.levels, positions);
+    let out = if args.limit && !args.quads {
+        subdyn::mesh::split_quads(&out)
+    } else {
+        out
+    };
 
     progress.stage(format!("writing {}", args.output.display()));
     let (written, write_s) = timed(|| write_mesh(&args.output, &out, None));

@@ -10,7 +10,9 @@ pub mod recover;
 pub mod refine_marks;
 mod report;
 mod sampling;
+mod start;
 
 pub use driver::{FitResult, fit_point_cloud, fit_screened_cloud};
 pub use params::{FitParams, Refinement, ToleranceStat};
 pub use report::{ErrorStats, FitReport, LevelReport};
+pub use start::{FitRun, FitStart, MIN_FIT_POINTS, fit_from_start, stat_name};

@@ -2,7 +2,9 @@
 
 mod point_cloud;
 mod poly_mesh;
+mod triangles;
 
 pub use point_cloud::PointCloud;
 pub use poly_mesh::PolyMesh;
 pub(crate) use poly_mesh::check_finite;
+pub use triangles::split_quads;
