@@ -68,23 +68,9 @@ pub struct BenchSubdivideArgs {
     /// Stencil applications timed; the best is reported.
     #[arg(long, value_name = "R", default_value_t = 5)]
     pub repeat: usize,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_name = "T")]
-    pub threads: Option<usize>,
     /// No progress display.
     #[arg(short, long)]
     pub quiet: bool,
-}
-
-/// Sets the number of worker threads of a benchmark (`None`: all cores).
-pub fn set_threads(threads: Option<usize>) -> anyhow::Result<()> {
-    if let Some(t) = threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build_global()
-            .map_err(|e| anyhow::anyhow!("cannot start {t} threads: {e}"))?;
-    }
-    Ok(())
 }
 
 /// Runs a benchmark.
@@ -136,7 +122,6 @@ fn bench_subdivide(args: &BenchSubdivideArgs) -> anyhow::Result<()> {
     if args.repeat == 0 {
         anyhow::bail!("--repeat must be at least 1");
     }
-    set_threads(args.threads)?;
     let progress = Progress::new(args.quiet);
     let t = measure(args, &progress)?;
     drop(progress);

@@ -16,7 +16,9 @@ use subdyn::mesh::{PointCloud, PolyMesh};
 use subdyn::metrics::{CompareParams, Comparison, OneSided, Surface, compare, compare_points};
 use subdyn::subdivision::RefineOptions;
 
-use super::common::{about_file, bbox_json, print_stdout, seconds, thousands, timed, write_report};
+use super::common::{
+    about_file, bbox_json, check_output_dir, print_stdout, seconds, thousands, timed, write_report,
+};
 use super::options::{Boundary, read_polygon_mesh, warn_isolated};
 use super::progress::Progress;
 use super::subdivide::MAX_FACES;
@@ -80,6 +82,12 @@ enum Side {
 /// Runs `subdyn compare`.
 pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let start = Instant::now();
+    if let Some(p) = &args.report {
+        check_output_dir(p)?;
+    }
+    if let Some(p) = &args.distances_out {
+        check_output_dir(p)?;
+    }
     if args.samples > MAX_SAMPLES {
         anyhow::bail!(
             "--samples {} is out of range: expected 0 to {}",
@@ -173,7 +181,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
 /// Reads `A`: a polygon mesh, or (no faces) a point cloud with its normals.
 fn read_side(path: &Path, quiet: bool) -> anyhow::Result<Side> {
     let format = MeshFormat::from_path(path).map_err(|e| about_file(e, path))?;
-    let bytes = std::fs::read(path).map_err(|e| subdyn::Error::io(path, e))?;
+    let bytes = subdyn::io::read_input(path)?;
     let mesh = read_mesh_from_bytes(&bytes, format, path).map_err(|e| about_file(e, path))?;
     if mesh.num_faces() > 0 {
         warn_isolated(&mesh, &path.display().to_string(), quiet);

@@ -18,7 +18,7 @@ use subdyn::lattice::MAX_LATTICE_LEVELS;
 use subdyn::math::{Point3, Vector3};
 
 use super::common::{
-    about_file, check_mesh_output, print_stdout, seconds, thousands, write_report,
+    about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, write_report,
 };
 use super::options::read_polygon_mesh;
 use super::progress::Progress;
@@ -75,7 +75,7 @@ struct Move {
 
 /// The moved control points from a moves file.
 fn read_moves(path: &Path, rest: &[Point3]) -> anyhow::Result<Vec<Point3>> {
-    let bytes = std::fs::read(path).map_err(|e| subdyn::Error::io(path, e))?;
+    let bytes = subdyn::io::read_input(path)?;
     let file: MovesFile = serde_json::from_slice(&bytes)
         .map_err(|e| subdyn::Error::parse(path, e.line(), e.to_string()))?;
     let mut out = rest.to_vec();
@@ -101,6 +101,9 @@ fn read_moves(path: &Path, rest: &[Point3]) -> anyhow::Result<Vec<Point3>> {
 pub fn run(args: &FfdArgs) -> anyhow::Result<()> {
     let start = Instant::now();
     check_mesh_output(&args.output)?;
+    if let Some(p) = &args.report {
+        check_output_dir(p)?;
+    }
     if args.levels == 0 || args.levels > MAX_LATTICE_LEVELS {
         anyhow::bail!(
             "--levels {} is out of range: expected 1 to {MAX_LATTICE_LEVELS}",

@@ -12,7 +12,8 @@ use subdyn::mesh::PolyMesh;
 use subdyn::subdivision::Hierarchy;
 
 use super::common::{
-    about_file, bbox_json, check_mesh_output, print_stdout, seconds, thousands, timed, write_report,
+    about_file, bbox_json, check_mesh_output, check_output_dir, print_stdout, seconds, thousands,
+    timed, write_report,
 };
 use super::options::{RefineArgs, read_polygon_mesh};
 use super::progress::Progress;
@@ -65,6 +66,9 @@ pub struct SubdivideArgs {
 pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
     let start = Instant::now();
     check_mesh_output(&args.output)?;
+    if let Some(p) = &args.report {
+        check_output_dir(p)?;
+    }
     if args.levels > MAX_LEVELS {
         anyhow::bail!(
             "--levels {} is too many: each level multiplies the faces by 4; at most {MAX_LEVELS} levels are allowed",
