@@ -109,7 +109,8 @@ fn bench_subdivide(args: &BenchSubdivideArgs) -> anyhow::Result<()> {
     if args.levels == 0 || args.levels > 8 {
         anyhow::bail!("--levels {} is out of range: expected 1 to 8", args.levels);
     }
-    let faces = (args.grid * args.grid) as f64 * 4f64.powi(args.levels as i32);
+    // In floating point: N × N overflows for a huge --grid.
+    let faces = (args.grid as f64).powi(2) * 4f64.powi(args.levels as i32);
     if faces > MAX_FACES as f64 {
         anyhow::bail!(
             "--grid {} --levels {} would make about {} faces (at most {} allowed)",
@@ -119,6 +120,11 @@ fn bench_subdivide(args: &BenchSubdivideArgs) -> anyhow::Result<()> {
             thousands(MAX_FACES)
         );
     }
+    super::subdivide::check_refinement_memory(
+        faces,
+        false,
+        &format!("--grid {} --levels {}", args.grid, args.levels),
+    )?;
     if args.repeat == 0 {
         anyhow::bail!("--repeat must be at least 1");
     }
