@@ -454,3 +454,85 @@ fn sigterm_during_a_write_leaves_no_temporary_file() {
     assert!(err.contains("SIGTERM"), "{err}");
     assert_eq!(files(d), ["cube.obj"], "files left behind");
 }
+
+/// A fan of `n` quads around one vertex (valence `n`) and a single `n`-gon.
+fn fan_and_polygon(dir: &Path, n: usize) {
+    use std::f64::consts::TAU;
+    let mut fan = String::from("v 0 0 0.3\n");
+    for i in 0..n {
+        let (a, b) = (TAU * i as f64 / n as f64, TAU * (i as f64 + 0.5) / n as f64);
+        fan += &format!(
+            "v {} {} 0\nv {} {} 0\n",
+            a.cos(),
+            a.sin(),
+            1.5 * b.cos(),
+            1.5 * b.sin()
+        );
+    }
+    for i in 0..n {
+        fan += &format!(
+            "f 1 {} {} {}\n",
+            2 + 2 * i,
+            3 + 2 * i,
+            2 + 2 * ((i + 1) % n)
+        );
+    }
+    std::fs::write(dir.join("fan.obj"), fan).unwrap();
+    let mut gon: String = (0..n)
+        .map(|i| {
+            let a = TAU * i as f64 / n as f64;
+            format!("v {} {} 0\n", a.cos(), a.sin())
+        })
+        .collect();
+    gon += "f";
+    for i in 1..=n {
+        gon += &format!(" {i}");
+    }
+    gon += "\n";
+    std::fs::write(dir.join("gon.obj"), gon).unwrap();
+}
+
+#[test]
+fn exact_limit_evaluation_refuses_huge_valences_and_polygons() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let n = subdyn::limit::MAX_EXACT_RING + 1;
+    fan_and_polygon(d, n);
+    let inputs = ["fan.obj", "gon.obj"];
+    let valence = format!("valence {n}");
+    let size = format!("{n} vertices");
+    refused(
+        d,
+        &["limit", "fan.obj", "-o", "o.obj"],
+        &["fan.obj", &valence, "at most 256"],
+        &inputs,
+    );
+    refused(
+        d,
+        &["limit", "gon.obj", "-o", "o.obj"],
+        &["gon.obj", &size, "at most 256"],
+        &inputs,
+    );
+    refused(
+        d,
+        &["render", "gon.obj", "--limit", "2", "-o", "o.png"],
+        &["gon.obj", &size],
+        &inputs,
+    );
+    refused(
+        d,
+        &["compare", "fan.obj", "gon.obj", "--limit-a"],
+        &["fan.obj", &valence],
+        &inputs,
+    );
+    // The same meshes subdivide to their limit positions (limit masks).
+    let out = run_subdyn(
+        d,
+        &["subdivide", "gon.obj", "-l", "1", "--limit", "-o", "s.obj"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
