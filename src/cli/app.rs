@@ -21,7 +21,7 @@ use super::{
 )]
 struct Cli {
     /// Worker threads (default: `RAYON_NUM_THREADS`, else one per core; at
-    /// most 4 per core). The results are the same bytes on any count.
+    /// most 4 per core).
     #[arg(long, global = true, value_name = "N")]
     threads: Option<usize>,
     /// Memory budget: a size such as `2G`, `512M` or `1500000000` (bytes).

@@ -1,6 +1,5 @@
 //! `--threads` (or `RAYON_NUM_THREADS`): the size of the worker pool, bounded
-//! by the machine. Results never depend on it (every parallel sum is split
-//! by the problem's size, see `subdyn::math::reduction_parts`), only the time.
+//! by the machine.
 
 /// Most worker threads per core that `--threads` accepts: oversubscribing a
 /// core a few times can make sense (testing, sharing a machine), thousands

@@ -188,3 +188,32 @@ pub fn remove_temporary_files() {
     }
     std::mem::forget(reg);
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stale_temporary_files_are_skipped_not_overwritten() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.txt");
+        // The names the next writes would take, left by a "killed" process
+        // with this id.
+        let next = SEQUENCE.load(Ordering::Relaxed);
+        let stale: Vec<PathBuf> = (next..next + 3)
+            .map(|n| {
+                dir.path()
+                    .join(format!(".out.txt.tmp.{}.{n}", std::process::id()))
+            })
+            .collect();
+        for s in &stale {
+            std::fs::write(s, b"stale").unwrap();
+        }
+        atomic_write(&path, |w| w.write_all(b"new\n")).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"new\n");
+        for s in &stale {
+            assert_eq!(std::fs::read(s).unwrap(), b"stale");
+        }
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 4);
+    }
+}
