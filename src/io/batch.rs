@@ -64,10 +64,10 @@ impl OutputBatch {
         reg.created_dirs.clear();
         let mut failed = None;
         for (temp, path) in staged {
-            if failed.is_none() {
-                if let Err(e) = std::fs::rename(&temp, &path) {
-                    failed = Some(Error::io(&path, e));
-                }
+            if failed.is_none()
+                && let Err(e) = std::fs::rename(&temp, &path)
+            {
+                failed = Some(Error::io(&path, e));
             }
             if failed.is_some() {
                 let _ = std::fs::remove_file(&temp);
