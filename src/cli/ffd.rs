@@ -93,6 +93,12 @@ fn read_moves(path: &Path, rest: &[Point3]) -> anyhow::Result<Vec<Point3>> {
             (None, Some(p)) => *q = Point3::new(p[0], p[1], p[2]),
             _ => anyhow::bail!("{name}: move {i}: give exactly one of \"offset\" and \"position\""),
         }
+        if !q.coords.iter().all(|x| x.is_finite()) {
+            anyhow::bail!(
+                "{name}: move {i}: vertex {} would move to a non-finite position",
+                m.vertex
+            );
+        }
     }
     Ok(out)
 }
@@ -143,9 +149,13 @@ pub fn run(args: &FfdArgs) -> anyhow::Result<()> {
     };
     let ffd = Ffd::new(&lattice, &mesh.positions, &params)?;
     let t = Instant::now();
+    // An error here is about the moved lattice, not the output.
+    let moves_source = (args.moves.as_ref())
+        .or(args.deformed.as_ref())
+        .unwrap_or(&args.lattice);
     let positions = ffd
         .deform(&moved)
-        .map_err(|e| about_file(e, &args.output))?;
+        .map_err(|e| about_file(e, moves_source))?;
     let deform_s = seconds(t);
     let mut out = mesh.clone();
     out.positions = positions;

@@ -237,7 +237,9 @@ pub(crate) fn file_samples(path: &Path) -> Result<u64> {
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    let header = |e: String| Error::parse(path, 0, format!("cannot read the image header: {e}"));
+    let header = |kind: &str, e: String| {
+        Error::parse(path, 0, format!("cannot read the {kind} header: {e}"))
+    };
     match ext.as_str() {
         "png" => {
             crate::io::open_regular(path)?;
@@ -246,13 +248,13 @@ pub(crate) fn file_samples(path: &Path) -> Result<u64> {
                 .with_guessed_format()
                 .map_err(|e| Error::io(path, e))?
                 .into_dimensions()
-                .map_err(|e| header(e.to_string()))?;
+                .map_err(|e| header("PNG", e.to_string()))?;
             Ok(u64::from(w) * u64::from(h))
         }
         "exr" => {
             crate::io::open_regular(path)?;
             let meta = ::exr::meta::MetaData::read_from_file(path, false)
-                .map_err(|e| header(e.to_string()))?;
+                .map_err(|e| header("EXR", e.to_string()))?;
             Ok(meta
                 .headers
                 .iter()
