@@ -30,6 +30,16 @@ pub enum Error {
     /// An argument or a value in the input is out of range (NaN coordinate, absurd parameter, …).
     #[error("input: {0}")]
     Input(String),
+    /// A step would allocate more than the memory budget ([`crate::memory`]).
+    #[error("{what} needs about {}, over the memory budget of {} (--max-memory sets it)", crate::memory::human_bytes(*bytes), crate::memory::human_bytes(*budget))]
+    Memory {
+        /// What would be allocated.
+        what: String,
+        /// The estimate, bytes.
+        bytes: u64,
+        /// The budget, bytes.
+        budget: u64,
+    },
     /// An iterative method stopped before reaching its tolerance.
     #[error("not converged: {0}")]
     NotConverged(String),

@@ -15,7 +15,7 @@
 //! # let _ = io::MeshFormat::Obj;
 //! ```
 //!
-//! Modules: [`math`] (scalar and point types), [`error`], [`mesh`] (polygon
+//! Modules: [`math`] (scalar and point types), [`error`], [`memory`] (the memory budget), [`mesh`] (polygon
 //! meshes, point clouds), [`io`] (OBJ, PLY, OFF, XYZ), [`topology`] (edges,
 //! adjacency, tags), [`subdivision`] (Catmull-Clark refinement, B-spline curves), [`stencil`]
 //! (CSR stencil tables), [`limit`] (limit masks, exact evaluation, closest point),
@@ -37,6 +37,7 @@ pub mod io;
 pub mod lattice;
 pub mod limit;
 pub mod math;
+pub mod memory;
 pub mod mesh;
 pub mod metrics;
 pub mod render;

@@ -10,7 +10,7 @@
 
 mod common;
 
-use common::run_subdyn;
+use common::{assert_clean_failure, files, run_subdyn};
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
@@ -99,38 +99,6 @@ fn torus_obj(n: usize, m: usize) -> String {
 fn info_json(dir: &Path, name: &str) -> Value {
     let out = ok(&run_subdyn(dir, &["info", name, "--json"]));
     serde_json::from_str(out.trim()).expect("info --json prints one JSON object")
-}
-
-/// The names of the files in `dir`.
-fn files(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
-
-/// Asserts a clean failure: exit code 1, exactly one stderr line
-/// `subdyn: error: …` containing every `needle` (case-insensitive), no panic
-/// text, and no file in `dir` other than `inputs`.
-fn assert_clean_failure(dir: &Path, out: &Output, needles: &[&str], inputs: &[&str]) {
-    let err = stderr(out);
-    assert_eq!(out.status.code(), Some(1), "exit code; stderr: {err}");
-    assert!(!err.contains("panicked"), "panic text in: {err}");
-    assert!(!err.contains("RUST_BACKTRACE"), "backtrace hint in: {err}");
-    let lines: Vec<&str> = err.lines().collect();
-    assert_eq!(lines.len(), 1, "expected one stderr line, got: {err}");
-    assert!(lines[0].starts_with("subdyn: error: "), "prefix: {err}");
-    for needle in needles {
-        assert!(
-            err.to_lowercase().contains(&needle.to_lowercase()),
-            "`{needle}` not in: {err}"
-        );
-    }
-    let mut expected: Vec<String> = inputs.iter().map(|s| s.to_string()).collect();
-    expected.sort();
-    assert_eq!(files(dir), expected, "files left behind");
 }
 
 /// `subdivide INPUT -o out.obj --levels 1` on a bad `INPUT` written into a

@@ -853,3 +853,31 @@ fn failed_mesh_write_keeps_the_previous_file() {
     assert!(write_mesh(&path, &mesh, Some(&wrong)).is_err());
     assert_eq!(std::fs::read(&path).unwrap(), b"v 0 0 0\n");
 }
+
+#[test]
+fn cr_only_and_crlf_line_ends_are_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in [
+        ("cr.obj", "v 0 0 0\rv 1 0 0\rv 0 1 0\rv 1 1 0\rf 1 2 4 3\r"),
+        (
+            "crlf.obj",
+            "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nv 1 1 0\r\nf 1 2 4 3\r\n",
+        ),
+        (
+            "cr.off",
+            "OFF\r4 1 0\r0 0 0\r1 0 0\r0 1 0\r1 1 0\r4 0 1 3 2\r",
+        ),
+    ] {
+        let mesh = read_mesh(file(&dir, name, text.as_bytes())).unwrap();
+        assert_eq!((mesh.num_vertices(), mesh.num_faces()), (4, 1), "{name}");
+    }
+    let cloud = read_points(file(&dir, "cr.xyz", b"0 0 0\r1 0 0\r0 1 0\r")).unwrap();
+    assert_eq!(cloud.positions.len(), 3);
+    // Line numbers count a CR-only line end once, a CRLF once.
+    let (line, _) = parse_error(read_mesh(file(
+        &dir,
+        "bad.obj",
+        b"v 0 0 0\r\nv 1 0\rf 1 2 3\r",
+    )));
+    assert_eq!(line, 2);
+}

@@ -326,6 +326,13 @@ fn nifti_bad_headers_give_one_clear_error() {
     cases.push(("offset.nii", h.header(), "beyond the end"));
     cases.push(("trunc.nii", good.file(&voxels[..5]), "truncated"));
     cases.push(("trunc.nii.gz", gzip(&good.file(&voxels[..5])), "truncated"));
+    // Whole voxels but a damaged gzip trailer: a wrong CRC-32, or none.
+    let gz = gzip(&good.file(&voxels));
+    let mut bad_crc = gz.clone();
+    let crc_at = bad_crc.len() - 8;
+    bad_crc[crc_at] ^= 0x55;
+    cases.push(("crc.nii.gz", bad_crc, "checksum"));
+    cases.push(("notrailer.nii.gz", gz[..gz.len() - 8].to_vec(), "gzip"));
     let mut h = good.clone();
     h.datatype = 32;
     cases.push(("complex.nii", h.file(&voxels), "datatype 32"));

@@ -5,11 +5,11 @@
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 use super::{
     bench, common, compare, ffd, finetune, fit, info, lattice, limit, recover, render, sculpt,
-    subdivide,
+    signals, subdivide, threads,
 };
 
 /// subdyn: Catmull-Clark subdivision surfaces — refinement as stencil tables,
@@ -20,6 +20,15 @@ use super::{
     after_help = "Output formats follow the extension: .obj, .ply, .off, .xyz (optionally .gz)."
 )]
 struct Cli {
+    /// Worker threads (default: `RAYON_NUM_THREADS`, else one per core; at
+    /// most 4 per core).
+    #[arg(long, global = true, value_name = "N")]
+    threads: Option<usize>,
+    /// Memory budget: a size such as `2G`, `512M` or `1500000000` (bytes).
+    /// Readers and verbs refuse, before allocating, anything estimated over
+    /// it (default: half of the physical memory, or of `ulimit -v`).
+    #[arg(long, global = true, value_name = "SIZE", value_parser = memory_size)]
+    max_memory: Option<u64>,
     #[command(subcommand)]
     command: Command,
 }
@@ -55,11 +64,51 @@ enum Command {
     Bench(bench::BenchCommand),
 }
 
+/// `--max-memory`'s value in bytes.
+fn memory_size(text: &str) -> Result<u64, String> {
+    subdyn::memory::parse_memory_size(text).map_err(|e| e.to_string())
+}
+
+/// The command line, with negative numbers accepted as the values of every
+/// option (`--tol -1` reaches the verb's own range check).
+fn command() -> clap::Command {
+    fn allow_negative(cmd: clap::Command) -> clap::Command {
+        cmd.mut_args(|a| {
+            if a.get_action().takes_values() {
+                a.allow_negative_numbers(true)
+            } else {
+                a
+            }
+        })
+        .mut_subcommands(allow_negative)
+    }
+    allow_negative(Cli::command())
+}
+
 /// Parses the command line, runs the verb and turns any error into one line
 /// on stderr and exit code 1.
 pub fn run() -> ExitCode {
     common::install_panic_hook();
-    let cli = Cli::parse();
+    let cli = match Cli::from_arg_matches_mut(&mut command().get_matches()) {
+        Ok(cli) => cli,
+        Err(err) => err.exit(),
+    };
+    if let Some(bytes) = cli.max_memory {
+        subdyn::memory::set_memory_budget(bytes);
+    }
+    if let Err(err) = threads::start_pool(cli.threads) {
+        common::print_error(&err);
+        return ExitCode::from(1);
+    }
+    signals::install();
+    // Every file of the run is staged and renamed at the end, all or none.
+    let batch = match subdyn::io::OutputBatch::begin() {
+        Ok(batch) => batch,
+        Err(err) => {
+            common::print_error(&err.into());
+            return ExitCode::from(1);
+        }
+    };
     let result = match cli.command {
         Command::Fit(args) => fit::run(&args),
         Command::Recover(args) => recover::run(&args),
@@ -74,6 +123,7 @@ pub fn run() -> ExitCode {
         Command::Sculpt(args) => sculpt::run(&args),
         Command::Bench(cmd) => bench::run(&cmd),
     };
+    let result = result.and_then(|()| Ok(batch.commit()?));
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
@@ -89,7 +139,6 @@ mod tests {
 
     #[test]
     fn the_command_line_definition_is_consistent() {
-        use clap::CommandFactory;
-        Cli::command().debug_assert();
+        command().debug_assert();
     }
 }

@@ -68,23 +68,9 @@ pub struct BenchSubdivideArgs {
     /// Stencil applications timed; the best is reported.
     #[arg(long, value_name = "R", default_value_t = 5)]
     pub repeat: usize,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_name = "T")]
-    pub threads: Option<usize>,
     /// No progress display.
     #[arg(short, long)]
     pub quiet: bool,
-}
-
-/// Sets the number of worker threads of a benchmark (`None`: all cores).
-pub fn set_threads(threads: Option<usize>) -> anyhow::Result<()> {
-    if let Some(t) = threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build_global()
-            .map_err(|e| anyhow::anyhow!("cannot start {t} threads: {e}"))?;
-    }
-    Ok(())
 }
 
 /// Runs a benchmark.
@@ -123,7 +109,8 @@ fn bench_subdivide(args: &BenchSubdivideArgs) -> anyhow::Result<()> {
     if args.levels == 0 || args.levels > 8 {
         anyhow::bail!("--levels {} is out of range: expected 1 to 8", args.levels);
     }
-    let faces = (args.grid * args.grid) as f64 * 4f64.powi(args.levels as i32);
+    // In floating point: N × N overflows for a huge --grid.
+    let faces = (args.grid as f64).powi(2) * 4f64.powi(args.levels as i32);
     if faces > MAX_FACES as f64 {
         anyhow::bail!(
             "--grid {} --levels {} would make about {} faces (at most {} allowed)",
@@ -133,10 +120,14 @@ fn bench_subdivide(args: &BenchSubdivideArgs) -> anyhow::Result<()> {
             thousands(MAX_FACES)
         );
     }
+    super::subdivide::check_refinement_memory(
+        faces,
+        false,
+        &format!("--grid {} --levels {}", args.grid, args.levels),
+    )?;
     if args.repeat == 0 {
         anyhow::bail!("--repeat must be at least 1");
     }
-    set_threads(args.threads)?;
     let progress = Progress::new(args.quiet);
     let t = measure(args, &progress)?;
     drop(progress);

@@ -17,7 +17,6 @@ use subdyn::math::{Point3, bbox_diagonal};
 use subdyn::mesh::PolyMesh;
 use subdyn::subdivision::{RefineOptions, Refiner};
 
-use super::bench::set_threads;
 use super::common::{print_stdout, thousands, timed};
 use super::options::read_polygon_mesh;
 use super::progress::Progress;
@@ -36,9 +35,6 @@ pub struct BenchClosestArgs {
     /// Tessellation rate of the baseline (K×K samples per quad).
     #[arg(long, value_name = "K", default_value_t = 8)]
     pub baseline_tess: usize,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_name = "T")]
-    pub threads: Option<usize>,
     /// No progress display.
     #[arg(short, long)]
     pub quiet: bool,
@@ -64,7 +60,6 @@ pub fn bench_closest(args: &BenchClosestArgs) -> anyhow::Result<()> {
             args.baseline_tess
         );
     }
-    set_threads(args.threads)?;
     let (mesh, name) = match &args.input {
         Some(path) => (
             read_polygon_mesh(path, args.quiet)?,

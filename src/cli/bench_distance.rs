@@ -20,7 +20,6 @@ use subdyn::math::{Point3, Real, bbox_diagonal, bounding_box};
 use subdyn::mesh::PolyMesh;
 use subdyn::metrics::{TriangleBvh, area_samples, closest_point_on_triangle, distances};
 
-use super::bench::set_threads;
 use super::common::{print_stdout, thousands, timed};
 use super::progress::Progress;
 
@@ -43,9 +42,6 @@ pub struct BenchDistanceArgs {
     /// Points of the brute-force subsample (default: about 2·10⁷ / M, at least 16).
     #[arg(long, value_name = "K")]
     pub brute: Option<usize>,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_name = "T")]
-    pub threads: Option<usize>,
     /// No progress display.
     #[arg(short, long)]
     pub quiet: bool,
@@ -76,7 +72,6 @@ pub fn bench_distance(args: &BenchDistanceArgs) -> anyhow::Result<()> {
     {
         anyhow::bail!("--near {f} is out of range: expected 0 ≤ F < 1");
     }
-    set_threads(args.threads)?;
     let progress = Progress::new(args.quiet);
     progress.stage("making the torus and the points");
     // Quads n × m with n ≈ 3m (the ratio of the two circumferences), 2nm ≈ M.

@@ -26,7 +26,6 @@ use subdyn::ffd::{Ffd, FfdParams};
 use subdyn::lattice::{BoxLatticeParams, LatticeHierarchy, box_grid, box_lattice, refined_cells};
 use subdyn::math::{Point3, Real, Vector3};
 
-use super::bench::set_threads;
 use super::common::{print_stdout, thousands, timed};
 use super::progress::Progress;
 
@@ -48,9 +47,6 @@ pub struct BenchFfdArgs {
     /// Embedding runs; the fastest is reported.
     #[arg(long, value_name = "R", default_value_t = 1)]
     pub repeat: usize,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_name = "T")]
-    pub threads: Option<usize>,
     /// No progress display.
     #[arg(short, long)]
     pub quiet: bool,
@@ -85,7 +81,6 @@ pub fn bench_ffd(args: &BenchFfdArgs) -> anyhow::Result<()> {
             args.repeat
         );
     }
-    set_threads(args.threads)?;
     let progress = Progress::new(args.quiet);
     progress.stage("making the torus");
     // n × m quads with n ≈ 3m (the ratio of the two circumferences), nm ≈ N.

@@ -14,7 +14,6 @@ use subdyn::fit::init::{InitParams, initial_mesh};
 use subdyn::fit::{FitParams, FitReport, fit_screened_cloud};
 use subdyn::io::read_points;
 
-use super::bench::set_threads;
 use super::common::{about_file, print_stdout, thousands, timed};
 use super::progress::Progress;
 
@@ -31,9 +30,6 @@ pub struct BenchFitArgs {
     /// Runs; the median is reported.
     #[arg(long, value_name = "R", default_value_t = 3)]
     pub repeat: usize,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_name = "T")]
-    pub threads: Option<usize>,
     /// No progress display.
     #[arg(short, long)]
     pub quiet: bool,
@@ -54,7 +50,6 @@ pub fn bench_fit(args: &BenchFitArgs) -> anyhow::Result<()> {
             args.repeat
         );
     }
-    set_threads(args.threads)?;
     let progress = Progress::new(args.quiet);
     progress.stage("reading the scan");
     let (cloud, read_s) = timed(|| match &args.input {

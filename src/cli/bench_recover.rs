@@ -30,7 +30,6 @@ use subdyn::math::{Point3, Real};
 use subdyn::subdivision::{RefineOptions, Refiner};
 use subdyn::volume::Volume;
 
-use super::bench::set_threads;
 use super::common::{print_stdout, thousands};
 use super::memory::{StagePeaks, current_rss, peak_rss, stage_peak};
 use super::progress::Progress;
@@ -47,9 +46,6 @@ pub struct BenchRecoverArgs {
     /// Recover the strongest edges instead of the 0.5 iso-surface.
     #[arg(long)]
     pub edges: bool,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_name = "T")]
-    pub threads: Option<usize>,
     /// No progress display.
     #[arg(short, long)]
     pub quiet: bool,
@@ -63,7 +59,6 @@ pub fn bench_recover(args: &BenchRecoverArgs) -> anyhow::Result<()> {
     if !(args.noise.is_finite() && (0.0..=1.0).contains(&args.noise)) {
         anyhow::bail!("--noise {} must be in [0, 1]", args.noise);
     }
-    set_threads(args.threads)?;
     let progress = Progress::new(args.quiet);
     let n = args.size;
     let c = (n as Real - 1.0) / 2.0;

@@ -32,7 +32,6 @@ use subdyn::math::{Point3, Real, Vector3};
 use subdyn::mesh::PolyMesh;
 use subdyn::solid::{ImplicitPreconditioner, Solid, SolidParams};
 
-use super::bench::set_threads;
 use super::common::{print_stdout, thousands, timed};
 use super::progress::Progress;
 
@@ -45,9 +44,6 @@ pub struct BenchSculptArgs {
     /// Explicit time step; the implicit step is ten times larger.
     #[arg(long, value_name = "DT", default_value_t = 2e-3)]
     pub dt: f64,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_name = "T")]
-    pub threads: Option<usize>,
     /// No progress display.
     #[arg(short, long)]
     pub quiet: bool,
@@ -223,7 +219,6 @@ pub fn bench_sculpt(args: &BenchSculptArgs) -> anyhow::Result<()> {
     if !(args.dt.is_finite() && args.dt > 0.0 && args.dt <= 1.0) {
         anyhow::bail!("--dt {} is out of range: expected 0 < DT ≤ 1", args.dt);
     }
-    set_threads(args.threads)?;
     let progress = Progress::new(args.quiet);
     let mut table = String::new();
     let mut lines = String::new();

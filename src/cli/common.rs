@@ -81,17 +81,11 @@ pub fn check_mesh_output(path: &Path) -> anyhow::Result<()> {
     check_output_dir(path)
 }
 
-/// Fails early (before any work) when the directory `path` would be written
-/// into does not exist, rather than after a long computation.
+/// Fails early (before any work) when no file can be written at `path` (its
+/// directory is missing or read-only, or `path` is a directory), rather than
+/// after a long computation.
 pub fn check_output_dir(path: &Path) -> anyhow::Result<()> {
-    match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => anyhow::bail!(
-            "{}: the directory {} does not exist",
-            path.display(),
-            dir.display()
-        ),
-        _ => Ok(()),
-    }
+    Ok(subdyn::io::check_writable(path)?)
 }
 
 /// Writes a JSON report atomically (pretty-printed, trailing newline).

@@ -18,7 +18,7 @@ use subdyn::lattice::MAX_LATTICE_LEVELS;
 use subdyn::math::{Point3, Vector3};
 
 use super::common::{
-    about_file, check_mesh_output, print_stdout, seconds, thousands, write_report,
+    about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, write_report,
 };
 use super::options::read_polygon_mesh;
 use super::progress::Progress;
@@ -75,7 +75,7 @@ struct Move {
 
 /// The moved control points from a moves file.
 fn read_moves(path: &Path, rest: &[Point3]) -> anyhow::Result<Vec<Point3>> {
-    let bytes = std::fs::read(path).map_err(|e| subdyn::Error::io(path, e))?;
+    let bytes = subdyn::io::read_input(path)?;
     let file: MovesFile = serde_json::from_slice(&bytes)
         .map_err(|e| subdyn::Error::parse(path, e.line(), e.to_string()))?;
     let mut out = rest.to_vec();
@@ -93,6 +93,12 @@ fn read_moves(path: &Path, rest: &[Point3]) -> anyhow::Result<Vec<Point3>> {
             (None, Some(p)) => *q = Point3::new(p[0], p[1], p[2]),
             _ => anyhow::bail!("{name}: move {i}: give exactly one of \"offset\" and \"position\""),
         }
+        if !q.coords.iter().all(|x| x.is_finite()) {
+            anyhow::bail!(
+                "{name}: move {i}: vertex {} would move to a non-finite position",
+                m.vertex
+            );
+        }
     }
     Ok(out)
 }
@@ -101,6 +107,9 @@ fn read_moves(path: &Path, rest: &[Point3]) -> anyhow::Result<Vec<Point3>> {
 pub fn run(args: &FfdArgs) -> anyhow::Result<()> {
     let start = Instant::now();
     check_mesh_output(&args.output)?;
+    if let Some(p) = &args.report {
+        check_output_dir(p)?;
+    }
     if args.levels == 0 || args.levels > MAX_LATTICE_LEVELS {
         anyhow::bail!(
             "--levels {} is out of range: expected 1 to {MAX_LATTICE_LEVELS}",
@@ -140,9 +149,13 @@ pub fn run(args: &FfdArgs) -> anyhow::Result<()> {
     };
     let ffd = Ffd::new(&lattice, &mesh.positions, &params)?;
     let t = Instant::now();
+    // An error here is about the moved lattice, not the output.
+    let moves_source = (args.moves.as_ref())
+        .or(args.deformed.as_ref())
+        .unwrap_or(&args.lattice);
     let positions = ffd
         .deform(&moved)
-        .map_err(|e| about_file(e, &args.output))?;
+        .map_err(|e| about_file(e, moves_source))?;
     let deform_s = seconds(t);
     let mut out = mesh.clone();
     out.positions = positions;

@@ -15,7 +15,7 @@ use subdyn::finetune::{
 use subdyn::math::Real;
 use subdyn::render::{check_png_path, write_png};
 
-use super::common::{about_file, print_stdout, warn, write_report};
+use super::common::{about_file, check_output_dir, print_stdout, warn, write_report};
 
 /// Arguments of `subdyn finetune curve`.
 #[derive(Debug, Args)]
@@ -77,6 +77,10 @@ pub fn run(args: &CurveArgs) -> anyhow::Result<()> {
     let (k_length, k_angle) = spring_coefficients(&args.k)?;
     if let Some(png) = &args.png {
         check_png_path(png)?;
+    }
+    check_output_dir(&args.output)?;
+    if let Some(p) = &args.report {
+        check_output_dir(p)?;
     }
     let (topo, points) = read_curve(&args.input).map_err(|e| about_file(e, &args.input))?;
     let alpha = read_alpha(&args.values, &topo).map_err(|e| about_file(e, &args.values))?;

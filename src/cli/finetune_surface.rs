@@ -15,7 +15,7 @@ use subdyn::math::Real;
 use subdyn::subdivision::NonUniformHierarchy;
 use subdyn::topology::Level;
 
-use super::common::{about_file, check_mesh_output, print_stdout, write_report};
+use super::common::{about_file, check_mesh_output, check_output_dir, print_stdout, write_report};
 use super::options::read_polygon_mesh;
 
 /// The scheme of the input mesh.
@@ -77,8 +77,8 @@ pub struct SurfaceArgs {
 
 /// Reads the edge-values JSON into `(i, j, a)` triples for every edge of `level`.
 pub fn read_edge_values(path: &Path, level: &Level) -> anyhow::Result<Vec<(u32, u32, Real)>> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let text = String::from_utf8(subdyn::io::read_input(path)?)
+        .map_err(|_| anyhow::anyhow!("{}: not UTF-8 text", path.display()))?;
     let bad = |msg: String| anyhow::anyhow!("{}: {msg}", path.display());
     let v: Value = serde_json::from_str(&text).map_err(|e| bad(format!("not valid JSON: {e}")))?;
     let obj = v
@@ -131,6 +131,12 @@ pub fn run(args: &SurfaceArgs) -> anyhow::Result<()> {
     check_mesh_output(&args.output)?;
     if let Some(r) = &args.refined {
         check_mesh_output(r)?;
+    }
+    if let Some(p) = &args.knots_out {
+        check_output_dir(p)?;
+    }
+    if let Some(p) = &args.report {
+        check_output_dir(p)?;
     }
     if args.levels > 6 {
         anyhow::bail!(

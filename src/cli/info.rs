@@ -33,7 +33,7 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
         return super::info_volume::run(path, args.json);
     }
     let format = MeshFormat::from_path(path)?;
-    let bytes = std::fs::read(path).map_err(|e| subdyn::Error::io(path, e))?;
+    let bytes = subdyn::io::read_input(path)?;
     let mesh = read_mesh_from_bytes(&bytes, format, path).map_err(|e| about_file(e, path))?;
     let cloud = read_points_from_bytes(&bytes, format, path).map_err(|e| about_file(e, path))?;
     let normals = cloud.normals.is_some();

@@ -13,7 +13,7 @@ use subdyn::lattice::{
     BoxKind, BoxLatticeParams, box_lattice, locally_refined, shrunk_box_lattice,
 };
 
-use super::common::{about_file, print_stdout, thousands, write_report};
+use super::common::{about_file, check_output_dir, print_stdout, thousands, write_report};
 
 /// Box orientation on the command line.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -67,6 +67,10 @@ pub fn run(args: &LatticeArgs) -> anyhow::Result<()> {
             "{}: the lattice is written as JSON; use a .json name",
             args.output.display()
         );
+    }
+    check_output_dir(&args.output)?;
+    if let Some(p) = &args.report {
+        check_output_dir(p)?;
     }
     let mesh = read_mesh(&args.model).map_err(|e| about_file(e, &args.model))?;
     let params = BoxLatticeParams {

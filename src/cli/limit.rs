@@ -10,7 +10,8 @@ use subdyn::io::write_mesh;
 use subdyn::limit::tessellate;
 
 use super::common::{
-    about_file, bbox_json, check_mesh_output, print_stdout, seconds, thousands, timed, write_report,
+    about_file, bbox_json, check_mesh_output, check_output_dir, print_stdout, seconds, thousands,
+    timed, write_report,
 };
 use super::options::{LimitFacesArgs, RefineArgs, read_polygon_mesh};
 use super::progress::Progress;
@@ -52,6 +53,9 @@ pub struct LimitArgs {
 pub fn run(args: &LimitArgs) -> anyhow::Result<()> {
     let start = Instant::now();
     check_mesh_output(&args.output)?;
+    if let Some(p) = &args.report {
+        check_output_dir(p)?;
+    }
     if args.tess == 0 || args.tess > MAX_TESS {
         anyhow::bail!(
             "--tess {} is out of range: expected 1 to {MAX_TESS}",

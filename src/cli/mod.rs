@@ -28,7 +28,9 @@ mod render;
 mod sculpt;
 mod sculpt_demo;
 mod sculpt_script;
+mod signals;
 mod subdivide;
 mod subdivide_scheme;
+mod threads;
 
 pub use app::run;

@@ -134,6 +134,9 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     if let Some(p) = &args.report {
         check_output_dir(p)?;
     }
+    if let Some(dir) = &args.slices_png {
+        subdyn::io::check_output_dir_path(dir)?;
+    }
     if args.tess == 0 || args.tess > 64 {
         anyhow::bail!("--tess {} is out of range: expected 1 to 64", args.tess);
     }
@@ -350,7 +353,7 @@ fn write_slices(
     initial: &PolyMesh,
 ) -> anyhow::Result<Vec<String>> {
     use subdyn::render::{slice_overlay, write_png};
-    std::fs::create_dir_all(dir).map_err(|e| about_file(subdyn::Error::io(dir, e), dir))?;
+    subdyn::io::create_output_dir(dir)?;
     let idx: Vec<[Real; 3]> = surface
         .positions
         .iter()

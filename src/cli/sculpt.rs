@@ -130,6 +130,7 @@ struct MovingRope {
 
 /// Runs the verb.
 pub fn run(args: &SculptArgs) -> anyhow::Result<()> {
+    subdyn::io::check_output_dir_path(&args.out_dir)?;
     if args.every == 0 || args.every > MAX_STEPS {
         anyhow::bail!(
             "--every {} is out of range: expected 1 to {MAX_STEPS}",
@@ -156,12 +157,7 @@ pub fn run(args: &SculptArgs) -> anyhow::Result<()> {
         let lattice = read_lattice(lat).map_err(|e| about_file(e, lat))?;
         (lattice, read_script(path)?, lat.display().to_string())
     };
-    std::fs::create_dir_all(&args.out_dir).with_context(|| {
-        format!(
-            "cannot create the output directory {}",
-            args.out_dir.display()
-        )
-    })?;
+    subdyn::io::create_output_dir(&args.out_dir)?;
     let progress = Progress::new(args.quiet);
     progress.stage(format!("building the level-{} solid", args.level));
     let params = solid_params(args.level, &script.material);

@@ -203,8 +203,8 @@ fn one_of(name: &str, index: bool, near: &Option<[Real; 3]>) -> anyhow::Result<(
 
 /// Reads a script file.
 pub fn read_script(path: &Path) -> anyhow::Result<Script> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read the script {}", path.display()))?;
+    let text = String::from_utf8(subdyn::io::read_input(path)?)
+        .map_err(|_| anyhow::anyhow!("{}: the script is not UTF-8 text", path.display()))?;
     parse_script(&text, &path.display().to_string())
 }
 

@@ -12,7 +12,8 @@ use subdyn::mesh::PolyMesh;
 use subdyn::subdivision::Hierarchy;
 
 use super::common::{
-    about_file, bbox_json, check_mesh_output, print_stdout, seconds, thousands, timed, write_report,
+    about_file, bbox_json, check_mesh_output, check_output_dir, print_stdout, seconds, thousands,
+    timed, write_report,
 };
 use super::options::{RefineArgs, read_polygon_mesh};
 use super::progress::Progress;
@@ -65,6 +66,9 @@ pub struct SubdivideArgs {
 pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
     let start = Instant::now();
     check_mesh_output(&args.output)?;
+    if let Some(p) = &args.report {
+        check_output_dir(p)?;
+    }
     if args.levels > MAX_LEVELS {
         anyhow::bail!(
             "--levels {} is too many: each level multiplies the faces by 4; at most {MAX_LEVELS} levels are allowed",
@@ -79,7 +83,7 @@ pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
         None => "embedded:cube".to_string(),
     };
     let mesh = mesh?;
-    check_size(&mesh, args.levels, &input_name)?;
+    check_size(&mesh, args.levels, args.limit, &input_name)?;
     if args.scheme != Scheme::CatmullClark {
         return run_other(args, &mesh, &input_name);
     }
@@ -200,8 +204,9 @@ fn load(input: Option<&Path>, quiet: bool) -> (anyhow::Result<PolyMesh>, String)
     }
 }
 
-/// Refuses, before allocating anything, a refinement that would exceed [`MAX_FACES`].
-fn check_size(mesh: &PolyMesh, levels: usize, name: &str) -> anyhow::Result<()> {
+/// Refuses, before allocating anything, a refinement that would exceed
+/// [`MAX_FACES`] or the memory budget ([`check_refinement_memory`]).
+fn check_size(mesh: &PolyMesh, levels: usize, limit: bool, name: &str) -> anyhow::Result<()> {
     let faces = estimated_faces(mesh, levels);
     if faces > MAX_FACES as f64 {
         anyhow::bail!(
@@ -210,6 +215,29 @@ fn check_size(mesh: &PolyMesh, levels: usize, name: &str) -> anyhow::Result<()> 
             thousands(MAX_FACES)
         );
     }
+    check_refinement_memory(faces, limit, &format!("{levels} levels of {name}"))
+}
+
+/// Bytes a refinement holds per face of its finest level (all levels'
+/// topology, the stencils and the positions; measured on a 12,100-quad
+/// torus: about 360 B at levels 3 and 4, and 920 B with `--limit`, whose
+/// limit stencils are wider).
+const BYTES_PER_FACE: f64 = 400.0;
+/// [`BYTES_PER_FACE`] with the limit stencils of `--limit`.
+const BYTES_PER_LIMIT_FACE: f64 = 1100.0;
+
+/// Refuses a refinement to `faces` faces whose estimated memory is over the
+/// budget (`--max-memory`).
+pub fn check_refinement_memory(faces: f64, limit: bool, what: &str) -> anyhow::Result<()> {
+    let each = if limit {
+        BYTES_PER_LIMIT_FACE
+    } else {
+        BYTES_PER_FACE
+    };
+    subdyn::memory::check_memory(
+        &format!("{what} ({} faces)", thousands(faces as usize)),
+        (faces * each).min(u64::MAX as f64) as u64,
+    )?;
     Ok(())
 }
 

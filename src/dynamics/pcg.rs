@@ -72,7 +72,8 @@ pub fn pcg(
     let diag = a.diagonal();
     if let Some(i) = diag.iter().position(|&d| !(d > 0.0 && d.is_finite())) {
         return Err(Error::Input(format!(
-            "pcg: diagonal entry {i} is {}; the matrix is not positive definite",
+            "pcg: diagonal entry {i} is {}, so the matrix is not positive definite (an unknown that \
+             nothing touches, such as an isolated vertex of the mesh, has no mass or stiffness)",
             diag[i]
         )));
     }

@@ -49,15 +49,16 @@ struct ValuesFile {
 
 /// Reads a JSON file into `T`, with the line of a syntax or shape error.
 fn read_json<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T> {
-    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
-    if meta.len() > MAX_BYTES {
+    let bytes = crate::io::read_input(path)?;
+    if bytes.len() as u64 > MAX_BYTES {
         return Err(Error::parse(
             path,
             0,
             format!("file is larger than {MAX_BYTES} bytes"),
         ));
     }
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = String::from_utf8(bytes)
+        .map_err(|_| Error::parse(path, 0, "the file is not UTF-8 text"))?;
     serde_json::from_str(&text).map_err(|e| Error::parse(path, e.line(), e.to_string()))
 }
 

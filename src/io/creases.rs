@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::source::read_file;
+use super::source::read_input;
 use super::text::{content_lines, parse_count, parse_real};
 use crate::error::{Error, Result};
 use crate::math::Real;
@@ -25,7 +25,7 @@ use crate::math::Real;
 /// ```
 pub fn read_creases(path: impl AsRef<Path>) -> Result<Vec<(u32, u32, Real)>> {
     let path = path.as_ref();
-    let bytes = read_file(path)?;
+    let bytes = read_input(path)?;
     let mut creases = Vec::new();
     for item in content_lines(&bytes, path) {
         let (line, text) = item?;

@@ -73,7 +73,7 @@ struct LatticeFile {
 /// Reads a lattice JSON file.
 pub fn read_lattice(path: impl AsRef<Path>) -> Result<Lattice> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = super::read_input(path)?;
     lattice_from_json(&bytes, path)
 }
 

@@ -14,6 +14,7 @@
 //! ```
 
 mod atomic;
+mod batch;
 mod creases;
 mod format;
 mod lattice;
@@ -28,7 +29,8 @@ mod volume;
 mod write;
 mod xyz;
 
-pub use atomic::atomic_write;
+pub use atomic::{atomic_write, check_writable, remove_temporary_files};
+pub use batch::{OutputBatch, check_output_dir_path, create_output_dir};
 pub use creases::read_creases;
 pub use format::MeshFormat;
 pub use lattice::{
@@ -37,5 +39,7 @@ pub use lattice::{
 pub use read::{
     read_mesh, read_mesh_from_bytes, read_obj_from_bytes, read_points, read_points_from_bytes,
 };
+pub(crate) use source::open_regular;
+pub use source::read_input;
 pub use volume::{VolumeFile, VolumeFormat, VolumeReadOptions, read_volume};
 pub use write::{write_mesh, write_points};

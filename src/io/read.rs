@@ -5,7 +5,7 @@ use std::path::Path;
 
 use super::format::MeshFormat;
 use super::raw::RawGeometry;
-use super::source::{contents, read_file};
+use super::source::{contents, read_input};
 use super::{obj, off, ply, xyz};
 use crate::error::Result;
 use crate::mesh::{PointCloud, PolyMesh};
@@ -26,7 +26,7 @@ use crate::mesh::{PointCloud, PolyMesh};
 pub fn read_mesh(path: impl AsRef<Path>) -> Result<PolyMesh> {
     let path = path.as_ref();
     let format = MeshFormat::from_path(path)?;
-    read_mesh_from_bytes(&read_file(path)?, format, path)
+    read_mesh_from_bytes(&read_input(path)?, format, path)
 }
 
 /// Reads the points of any supported file (optionally `.gz`), with their
@@ -42,7 +42,7 @@ pub fn read_mesh(path: impl AsRef<Path>) -> Result<PolyMesh> {
 pub fn read_points(path: impl AsRef<Path>) -> Result<PointCloud> {
     let path = path.as_ref();
     let format = MeshFormat::from_path(path)?;
-    read_points_from_bytes(&read_file(path)?, format, path)
+    read_points_from_bytes(&read_input(path)?, format, path)
 }
 
 /// [`read_mesh`] for a file already in memory (for instance `include_bytes!`);

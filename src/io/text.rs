@@ -7,32 +7,50 @@ use std::path::Path;
 use crate::error::{Error, Result};
 use crate::math::{Point3, Real, Vector3};
 
-/// The lines of `bytes` that carry content, as `(line_number, text)`: numbers
-/// are 1-based, `#` comments are cut off, ASCII whitespace (including `\r`) is
-/// trimmed and lines left blank are skipped. A line that is not UTF-8 once its
-/// comment is cut off is an error naming the line.
+/// The lines of `bytes` that carry content, as `(line_number, text)`: a line
+/// ends at `\n`, `\r\n` or a lone `\r` (old Mac files), numbers are 1-based,
+/// `#` comments are cut off, ASCII whitespace is trimmed and lines left blank
+/// are skipped. A line that is not UTF-8 once its comment is cut off is an
+/// error naming the line.
 pub(crate) fn content_lines<'a>(
     bytes: &'a [u8],
     path: &'a Path,
 ) -> impl Iterator<Item = Result<(usize, &'a str)>> + 'a {
-    bytes
-        .split(|&b| b == b'\n')
-        .enumerate()
-        .filter_map(move |(i, raw)| {
-            let raw = match raw.iter().position(|&b| b == b'#') {
-                Some(k) => &raw[..k],
-                None => raw,
-            };
-            let raw = raw.trim_ascii();
-            if raw.is_empty() {
-                return None;
+    let mut rest = Some(bytes);
+    std::iter::from_fn(move || {
+        let text = rest?;
+        match text.iter().position(|&b| b == b'\n' || b == b'\r') {
+            Some(k) => {
+                let end = if text[k] == b'\r' && text.get(k + 1) == Some(&b'\n') {
+                    k + 2
+                } else {
+                    k + 1
+                };
+                rest = Some(&text[end..]);
+                Some(&text[..k])
             }
-            Some(
-                std::str::from_utf8(raw)
-                    .map(|s| (i + 1, s))
-                    .map_err(|_| Error::parse(path, i + 1, "the line is not valid UTF-8 text")),
-            )
-        })
+            None => {
+                rest = None;
+                Some(text)
+            }
+        }
+    })
+    .enumerate()
+    .filter_map(move |(i, raw)| {
+        let raw = match raw.iter().position(|&b| b == b'#') {
+            Some(k) => &raw[..k],
+            None => raw,
+        };
+        let raw = raw.trim_ascii();
+        if raw.is_empty() {
+            return None;
+        }
+        Some(
+            std::str::from_utf8(raw)
+                .map(|s| (i + 1, s))
+                .map_err(|_| Error::parse(path, i + 1, "the line is not valid UTF-8 text")),
+        )
+    })
 }
 
 /// Parses one number (`inf` and `nan` are accepted here and rejected by the

@@ -71,6 +71,41 @@ pub struct LimitStencils {
     pub dvv: StencilTable,
 }
 
+/// The largest vertex valence and polygon size that exact limit evaluation
+/// accepts. Its local patches are dense in the ring around a face, so the
+/// time grows about as the fourth power of the valence (a valence-400
+/// vertex takes 7 s, 800 over two minutes); a valence or face this large
+/// is refused with an error naming it. `subdivide --limit` (limit masks)
+/// has no such limit.
+pub const MAX_EXACT_RING: usize = 256;
+
+/// Fails when face `face` has more than [`MAX_EXACT_RING`] vertices or one
+/// of its vertices more than [`MAX_EXACT_RING`] edges.
+fn check_face_rings(level: &Level, face: usize) -> Result<()> {
+    let fv = level.face_vertices(face);
+    if fv.len() > MAX_EXACT_RING {
+        return Err(Error::Input(format!(
+            "face {face} has {} vertices; exact limit evaluation takes faces of at most {MAX_EXACT_RING} (subdivide it first, or use subdivide --limit)",
+            fv.len()
+        )));
+    }
+    match fv
+        .iter()
+        .find(|&&v| level.valence(v as usize) > MAX_EXACT_RING)
+    {
+        Some(&v) => Err(Error::Input(format!(
+            "vertex {v} has valence {}; exact limit evaluation takes vertices of valence at most {MAX_EXACT_RING} (use subdivide --limit)",
+            level.valence(v as usize)
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// [`check_face_rings`] for every face of `level`, before work on the whole mesh.
+pub(crate) fn check_ring_sizes(level: &Level) -> Result<()> {
+    (0..level.num_faces()).try_for_each(|f| check_face_rings(level, f))
+}
+
 /// Evaluates the Catmull-Clark limit surface of a control mesh exactly.
 ///
 /// ```
@@ -139,6 +174,7 @@ impl LimitEvaluator {
                 "parameter ({u}, {v}) of face {face} outside [0, {umax}]²"
             )));
         }
+        check_face_rings(&self.level, face)?;
         Ok(evaluate_face(&self.level, &self.sharp, face, u, v))
     }
 

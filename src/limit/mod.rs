@@ -13,7 +13,7 @@ mod vertex_masks;
 
 pub use bspline::{cubic_basis, patch_weights};
 pub use closest::{ClosestPoint, ClosestPointEngine, ClosestPointParams};
-pub use evaluator::{LimitEvaluator, LimitPoint, LimitStencils, Sample};
+pub use evaluator::{LimitEvaluator, LimitPoint, LimitStencils, MAX_EXACT_RING, Sample};
 pub use interpolate::interpolate_limit_points;
 pub use limit_stencil::{limit_stencil, limit_tangent_stencils};
 pub use patch::SampleStencil;

@@ -209,6 +209,7 @@ impl PatchTable {
                 refiner.level.num_vertices
             )));
         }
+        super::evaluator::check_ring_sizes(&refiner.level)?;
         let h = refiner.refine_uniform(level)?;
         let fine = h.finest();
         let sharp = h.sharpness.last().expect("levels exist");

@@ -156,14 +156,15 @@ pub fn write_png(path: &Path, picture: &Picture) -> Result<()> {
     atomic_write(path, |w| picture.encode_png(w))
 }
 
-/// Fails unless `path` ends in `.png` (any case).
+/// Fails unless `path` ends in `.png` (any case) and a file can be written
+/// there ([`crate::io::check_writable`]).
 pub fn check_png_path(path: &Path) -> Result<()> {
     let is_png = path
         .extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("png"));
     if is_png {
-        Ok(())
+        crate::io::check_writable(path)
     } else {
         Err(Error::Input(format!(
             "{}: pictures are written as PNG; the file name must end in .png",

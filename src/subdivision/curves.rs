@@ -63,9 +63,9 @@ impl CurveTopology {
         let need = if closed { 3 } else { scheme.degree() + 1 };
         if num_points < need || num_points > MAX_POINTS {
             return Err(Error::Input(format!(
-                "a {} {:?} curve needs {need} to {MAX_POINTS} control points, got {num_points}",
-                if closed { "closed" } else { "open" },
-                scheme
+                "{} {} curve needs {need} to {MAX_POINTS} control points, got {num_points}",
+                if closed { "a closed" } else { "an open" },
+                format!("{scheme:?}").to_lowercase()
             )));
         }
         Ok(CurveTopology {

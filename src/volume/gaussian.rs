@@ -47,14 +47,17 @@ fn kernels_of(volume: &Volume, sigma: Real) -> Result<Vec<Vec<f32>>> {
     }
     let dims = volume.dims();
     let spacing = volume.spacing();
-    let kernels: Vec<Vec<f32>> = (0..3).map(|a| kernel(sigma / spacing[a])).collect();
-    if let Some(a) = (0..3).find(|&a| kernels[a].len() / 2 > 4 * dims[a].max(64)) {
-        return Err(Error::Input(format!(
-            "smoothing sigma {sigma} spans {} voxels along axis {a}, far beyond the volume",
-            kernels[a].len() / 2
-        )));
+    // The half-width is checked before a kernel is built: σ = 1e9 would
+    // otherwise allocate gigabytes first.
+    for a in 0..3 {
+        let half = half_width(sigma / spacing[a]);
+        if half > (4 * dims[a].max(64)) as Real {
+            return Err(Error::Input(format!(
+                "smoothing sigma {sigma} spans {half:.0} voxels along axis {a}, far beyond the volume"
+            )));
+        }
     }
-    Ok(kernels)
+    Ok((0..3).map(|a| kernel(sigma / spacing[a])).collect())
 }
 
 /// The three 1D passes on `data` in place. Each pass copies what one task
@@ -125,12 +128,22 @@ fn smooth_in_place(data: &mut [f32], dims: [usize; 3], kernels: &[Vec<f32>]) {
     }
 }
 
+/// The kernel's half-width `r = ⌈3σ⌉` (0 for σ < 0.1 voxel), as a float so
+/// that an absurd σ is not cut to an integer before it is checked.
+fn half_width(sigma_voxels: Real) -> Real {
+    if sigma_voxels < 0.1 {
+        0.0
+    } else {
+        (TRUNCATE * sigma_voxels).ceil()
+    }
+}
+
 /// Normalised Gaussian taps at offsets `−r ..= r`, `r = ⌈3σ⌉`; `[1]` for σ < 0.1 voxel.
 fn kernel(sigma_voxels: Real) -> Vec<f32> {
     if sigma_voxels < 0.1 {
         return vec![1.0];
     }
-    let r = (TRUNCATE * sigma_voxels).ceil() as isize;
+    let r = half_width(sigma_voxels) as isize;
     let w: Vec<Real> = (-r..=r)
         .map(|t| (-0.5 * (t as Real / sigma_voxels).powi(2)).exp())
         .collect();

@@ -508,4 +508,41 @@ pub fn run_subdyn(dir: &Path, args: &[&str]) -> std::process::Output {
         .expect("the subdyn binary runs")
 }
 
+/// The names of the files in `dir`.
+pub fn files(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Asserts a clean failure: exit code 1, exactly one stderr line
+/// `subdyn: error: …` containing every `needle` (case-insensitive), no panic
+/// text, and no file in `dir` other than `inputs`.
+pub fn assert_clean_failure(
+    dir: &Path,
+    out: &std::process::Output,
+    needles: &[&str],
+    inputs: &[&str],
+) {
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(1), "exit code; stderr: {err}");
+    assert!(!err.contains("panicked"), "panic text in: {err}");
+    assert!(!err.contains("RUST_BACKTRACE"), "backtrace hint in: {err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "expected one stderr line, got: {err}");
+    assert!(lines[0].starts_with("subdyn: error: "), "prefix: {err}");
+    for needle in needles {
+        assert!(
+            err.to_lowercase().contains(&needle.to_lowercase()),
+            "`{needle}` not in: {err}"
+        );
+    }
+    let mut expected: Vec<String> = inputs.iter().map(|s| s.to_string()).collect();
+    expected.sort();
+    assert_eq!(files(dir), expected, "files left behind");
+}
+
 pub mod volume;

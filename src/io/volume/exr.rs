@@ -54,6 +54,10 @@ pub(crate) fn exr_slice(path: &Path) -> Result<Slice> {
 
 /// A single EXR file as a volume one slice thick.
 pub(crate) fn read_exr_file(path: &Path) -> Result<Decoded> {
+    super::slices::check_decoded(
+        &format!("decoding {}", name(path)),
+        super::slices::file_samples(path)?,
+    )?;
     let s = exr_slice(path)?;
     let owned: PathBuf = path.to_path_buf();
     Ok(Decoded {

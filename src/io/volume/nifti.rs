@@ -4,7 +4,6 @@
 //! (decompressing) reader straight into f32, so a `.nii.gz` is never held
 //! uncompressed in full.
 
-use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::Path;
 
@@ -15,11 +14,43 @@ use super::nifti_header::{NIFTI1_HEADER_BYTES, nifti_header};
 use super::samples::{read_samples, skip_bytes};
 use crate::error::{Error, Result};
 
+/// Inflates the rest of a `.nii.gz` (the other volumes of a 4D file, at
+/// most what the header declares) so the gzip trailer's CRC and length are
+/// checked: a damaged or cut stream is an error, not a volume.
+fn check_gzip_end(
+    reader: &mut dyn Read,
+    header: &super::nifti_header::NiftiHeader,
+    count: usize,
+    path: &Path,
+) -> Result<()> {
+    let rest = (header.volumes.saturating_sub(1) as u64)
+        .saturating_mul(count as u64)
+        .saturating_mul(header.datatype.size() as u64)
+        // A few bytes of padding or extensions after the data.
+        .saturating_add(1 << 16);
+    let drained = std::io::copy(
+        &mut reader.take(rest.saturating_add(1)),
+        &mut std::io::sink(),
+    )
+    .map_err(|e| Error::parse(path, 0, format!("the gzip stream after the voxels: {e}")))?;
+    if drained > rest {
+        return Err(Error::parse(
+            path,
+            0,
+            format!(
+                "more data after the voxels than the header's {} volumes hold",
+                header.volumes
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Reads the first 3D volume of a NIfTI-1 file, in physical units
 /// (`scl_slope`, `scl_inter` applied) and world coordinates (see
 /// [`nifti_header`](super::nifti_header) for the map).
 pub(crate) fn read_nifti(path: &Path) -> Result<Decoded> {
-    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let file = crate::io::open_regular(path)?;
     let mut buffered = BufReader::with_capacity(1 << 16, file);
     let mut magic = [0u8; 2];
     let gzip = {
@@ -58,6 +89,9 @@ pub(crate) fn read_nifti(path: &Path) -> Result<Decoded> {
     }
     let count = header.dims.iter().product();
     let mut data = read_samples(&mut reader, count, header.datatype, header.big_endian, path)?;
+    if gzip {
+        check_gzip_end(&mut reader, &header, count, path)?;
+    }
     if let Some((slope, inter)) = header.scaling {
         for v in data.iter_mut() {
             *v = (slope * f64::from(*v) + inter) as f32;

@@ -3,7 +3,6 @@
 //! file is `BASE.raw`, or the sidecar's first `files` entry when the
 //! `.json` is given.
 
-use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
@@ -21,7 +20,7 @@ pub(crate) fn read_raw(path: &Path, sidecar: Option<&Sidecar>) -> Result<Decoded
             "a raw volume needs a JSON header BASE.json with at least \"dims\" beside it",
         )
     })?;
-    let data_path = data_file(path, side);
+    let data_path = data_file(path, side)?;
     let dtype = match &side.dtype {
         None => SampleType::F32,
         Some(name) => SampleType::from_name(name).ok_or_else(|| {
@@ -46,7 +45,7 @@ pub(crate) fn read_raw(path: &Path, sidecar: Option<&Sidecar>) -> Result<Decoded
             ));
         }
     };
-    let file = File::open(&data_path).map_err(|e| Error::io(&data_path, e))?;
+    let file = crate::io::open_regular(&data_path)?;
     let count: usize = side.dims.iter().product();
     let need = (count as u64) * dtype.size() as u64 + side.header_bytes;
     let len = file.metadata().map_err(|e| Error::io(&data_path, e))?.len();
@@ -85,16 +84,29 @@ pub(crate) fn read_raw(path: &Path, sidecar: Option<&Sidecar>) -> Result<Decoded
 }
 
 /// The data file: `path` itself unless it is the `.json`, then the sidecar's
-/// first `files` entry (relative to its directory) or `BASE.raw`.
-fn data_file(path: &Path, side: &Sidecar) -> PathBuf {
+/// first `files` entry or `BASE.raw`. A `files` entry must be a plain file
+/// name in the sidecar's directory: no directories, `..` or absolute paths.
+fn data_file(path: &Path, side: &Sidecar) -> Result<PathBuf> {
     if !path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"))
     {
-        return path.to_path_buf();
+        return Ok(path.to_path_buf());
     }
     match side.files.first() {
-        Some(f) => side.path.with_file_name(f),
-        None => side.path.with_extension("raw"),
+        Some(f) => {
+            let plain = Path::new(f)
+                .file_name()
+                .is_some_and(|name| name == std::ffi::OsStr::new(f.as_str()));
+            if !plain || f == ".." || f == "." {
+                return Err(Error::parse(
+                    &side.path,
+                    0,
+                    format!("files entry {f:?} is not a file name in the sidecar's directory"),
+                ));
+            }
+            Ok(side.path.with_file_name(f))
+        }
+        None => Ok(side.path.with_extension("raw")),
     }
 }

@@ -121,6 +121,10 @@ pub(crate) fn read_samples(
     let need = count
         .checked_mul(ty.size())
         .ok_or_else(|| Error::parse(path, 0, "the voxel data size overflows"))?;
+    crate::memory::check_memory(
+        &format!("reading {count} voxels of {} as f32", path.display()),
+        crate::memory::bytes_of(count as u64, 4),
+    )?;
     let mut out = Vec::new();
     out.try_reserve_exact(count).map_err(|_| {
         Error::parse(

@@ -69,7 +69,7 @@ pub(crate) fn read_sidecar(path: &Path) -> Result<Option<Sidecar>> {
     if !path.is_file() {
         return Ok(None);
     }
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = crate::io::read_input(path)?;
     let json: Value = serde_json::from_slice(&bytes)
         .map_err(|e| Error::parse(path, e.line(), format!("not valid JSON: {e}")))?;
     if json.get("dims").is_none() {

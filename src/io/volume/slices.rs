@@ -19,7 +19,7 @@ use rayon::prelude::*;
 
 use super::decoded::{Decoded, Placement};
 use super::exr::exr_slice;
-use super::tiff::tiff_pages;
+use super::tiff::{tiff_pages, tiff_samples};
 use crate::error::{Error, Result};
 
 /// One decoded 2D image.
@@ -44,6 +44,18 @@ pub(crate) fn read_slice_dir(dir: &Path) -> Result<Decoded> {
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
+    let samples = files
+        .iter()
+        .map(|f| file_samples(f))
+        .try_fold(0u64, |sum, n| n.map(|n| sum.saturating_add(n)))?;
+    check_decoded(
+        &format!(
+            "decoding the {} slice files of {}",
+            files.len(),
+            dir.display()
+        ),
+        samples,
+    )?;
     let decoded: Vec<Vec<Slice>> = files
         .par_iter()
         .map(|f| decode_file(f))
@@ -219,9 +231,54 @@ fn decode_file(path: &Path) -> Result<Vec<Slice>> {
     }
 }
 
+/// The samples a slice file decodes to, from its header alone.
+pub(crate) fn file_samples(path: &Path) -> Result<u64> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let header = |kind: &str, e: String| {
+        Error::parse(path, 0, format!("cannot read the {kind} header: {e}"))
+    };
+    match ext.as_str() {
+        "png" => {
+            crate::io::open_regular(path)?;
+            let (w, h) = image::ImageReader::open(path)
+                .map_err(|e| Error::io(path, e))?
+                .with_guessed_format()
+                .map_err(|e| Error::io(path, e))?
+                .into_dimensions()
+                .map_err(|e| header("PNG", e.to_string()))?;
+            Ok(u64::from(w) * u64::from(h))
+        }
+        "exr" => {
+            crate::io::open_regular(path)?;
+            let meta = ::exr::meta::MetaData::read_from_file(path, false)
+                .map_err(|e| header("EXR", e.to_string()))?;
+            Ok(meta
+                .headers
+                .iter()
+                .map(|h| {
+                    (h.layer_size.0 as u64)
+                        .saturating_mul(h.layer_size.1 as u64)
+                        .saturating_mul(h.channels.list.len() as u64)
+                })
+                .fold(0u64, u64::saturating_add))
+        }
+        _ => tiff_samples(path),
+    }
+}
+
+/// Refuses (before decoding) a stack of `samples` that would not fit the
+/// memory budget: the decoded slices as f32 and the stacked volume they are
+/// copied into, 8 bytes a sample.
+pub(crate) fn check_decoded(what: &str, samples: u64) -> Result<()> {
+    crate::memory::check_memory(what, crate::memory::bytes_of(samples, 8))
+}
+
 /// Decodes a PNG: 8/16-bit grey kept as stored; colour converted to luma.
 fn png_slice(path: &Path) -> Result<Slice> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = crate::io::read_input(path)?;
     let img = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
         .map_err(|e| Error::parse(path, 0, format!("cannot decode the PNG: {e}")))?;
     let (width, height) = (img.width() as usize, img.height() as usize);

@@ -8,7 +8,6 @@
 //! an ImageJ description the resolution tags are ignored (they are usually a
 //! print resolution such as 72 dpi).
 
-use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
@@ -18,11 +17,12 @@ use ::tiff::decoder::{Decoder, DecodingResult};
 use ::tiff::tags::Tag;
 
 use super::decoded::{Decoded, Placement};
-use super::slices::{Slice, name, stacked};
+use super::slices::{Slice, check_decoded, name, stacked};
 use crate::error::{Error, Result};
 
 /// Reads a (multi-page) TIFF file as a volume.
 pub(crate) fn read_tiff_stack(path: &Path) -> Result<Decoded> {
+    check_decoded(&format!("decoding {}", name(path)), tiff_samples(path)?)?;
     let (pages, spacing) = tiff_pages(path)?;
     let owned = path.to_path_buf();
     let stack = stacked(pages.into_iter().map(|s| (&owned, s)).collect())?;
@@ -41,10 +41,28 @@ pub(crate) fn read_tiff_stack(path: &Path) -> Result<Decoded> {
     })
 }
 
+/// The samples of every page of the TIFF at `path`, from the page headers
+/// alone (nothing is decoded), for the memory budget before decoding: a
+/// small file of many huge pages that share one strip decodes to gigabytes.
+pub(crate) fn tiff_samples(path: &Path) -> Result<u64> {
+    let bad = |e: ::tiff::TiffError| Error::parse(path, 0, format!("cannot decode the TIFF: {e}"));
+    let file = crate::io::open_regular(path)?;
+    let mut dec = Decoder::new(BufReader::new(file)).map_err(bad)?;
+    let mut total = 0u64;
+    loop {
+        let (w, h) = dec.dimensions().map_err(bad)?;
+        total = total.saturating_add(u64::from(w) * u64::from(h));
+        if !dec.more_images() {
+            return Ok(total);
+        }
+        dec.next_image().map_err(bad)?;
+    }
+}
+
 /// Every page of the TIFF at `path`, and the spacing its ImageJ metadata gives.
 pub(crate) fn tiff_pages(path: &Path) -> Result<(Vec<Slice>, Option<[f64; 3]>)> {
     let bad = |e: ::tiff::TiffError| Error::parse(path, 0, format!("cannot decode the TIFF: {e}"));
-    let file = File::open(path).map_err(|e| Error::io(path, e))?;
+    let file = crate::io::open_regular(path)?;
     // The tiff crate's default limits (256 MiB per page) turn an absurd page
     // size in a damaged header into an error instead of an allocation failure.
     let mut dec = Decoder::new(BufReader::new(file)).map_err(bad)?;
