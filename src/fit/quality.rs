@@ -60,9 +60,9 @@ impl Region {
         for p in points {
             let q = [p.x, p.y, p.z];
             let b = r.get_or_insert(Region { min: q, max: q });
-            for k in 0..3 {
-                b.min[k] = b.min[k].min(q[k]);
-                b.max[k] = b.max[k].max(q[k]);
+            for ((lo, hi), x) in b.min.iter_mut().zip(&mut b.max).zip(q) {
+                *lo = lo.min(x);
+                *hi = hi.max(x);
             }
         }
         r
