@@ -14,7 +14,8 @@ use subdyn::limit::tessellate;
 use subdyn::subdivision::{RefineOptions, Refiner};
 
 use super::common::{
-    about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, write_report,
+    about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, warn,
+    write_report,
 };
 use super::options::{LimitFacesArgs, read_polygon_mesh};
 use super::progress::Progress;
@@ -199,6 +200,9 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             map.insert("total_s".into(), json!(seconds(start)));
         }
         write_report(path, &value)?;
+    }
+    for w in &result.report.quality.warnings {
+        warn(args.quiet, w);
     }
     print_stdout(&summary(
         &name,

@@ -53,6 +53,7 @@ use crate::subdivision::{
 use crate::topology::face_of_corner;
 
 use super::init::outliers::{Screening, screen};
+use super::quality::assess;
 use super::refine_marks::{faces_above_noise, faces_off_data};
 use super::sampling::{shuffled_order, surface_samples, trimmed_rms};
 use super::{ErrorStats, FitParams, FitReport, LevelReport, Refinement};
@@ -163,6 +164,8 @@ pub fn fit_screened_cloud(
     // Most local structures at extraordinary vertices recur from level to
     // level: their quadtrees are built once.
     let quadtrees = QuadtreeCache::default();
+    // The distances of the last level kept, to assess the result with.
+    let mut final_dist: Vec<Real> = Vec::new();
     let (converged, stop_reason) = loop {
         let level = levels.len();
         let level_start = Instant::now();
@@ -439,6 +442,7 @@ pub fn fit_screened_cloud(
             continue;
         }
         levels.push(report);
+        final_dist.clone_from(&dist);
         let stat = params.tolerance_stat;
         if error.pct(stat) <= params.tolerance_pct {
             break (true, format!("tolerance met at level {level}"));
@@ -458,7 +462,7 @@ pub fn fit_screened_cloud(
             break (
                 false,
                 format!(
-                    "level {level} lowered the {:?} error by less than {:.0} %: finer levels would fit the noise",
+                    "level {level} lowered the {:?} error by less than {:.0} %: a finer level would gain little",
                     params.tolerance_stat,
                     100.0 * params.min_level_gain
                 ),
@@ -561,9 +565,12 @@ pub fn fit_screened_cloud(
         }
         mesh = next;
     };
+    let kept_dist: Vec<Real> = data_index.iter().map(|&i| final_dist[i]).collect();
+    let quality = assess(&mesh, &data, &data_tree, &kept_dist, diameter)?;
     Ok(FitResult {
         control: mesh,
         report: FitReport {
+            quality,
             points: points.len(),
             outliers,
             diameter,

@@ -6,6 +6,7 @@
 mod driver;
 pub mod init;
 mod params;
+pub mod quality;
 pub mod recover;
 pub mod refine_marks;
 mod report;

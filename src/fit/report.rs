@@ -134,4 +134,7 @@ pub struct FitReport {
     pub stop_reason: String,
     /// Total wall time, seconds.
     pub seconds: Real,
+    /// What the result itself shows: surface far from the data, points far
+    /// from the surface, folds ([`super::quality`]).
+    pub quality: super::quality::FitQuality,
 }

@@ -23,7 +23,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::limit::{ClosestPoint, PatchTable};
-use crate::math::{Point3, Real};
+use crate::math::{Point3, Real, reduction_parts};
 use crate::stencil::StencilTable;
 
 use super::SpringSystem;
@@ -295,10 +295,7 @@ impl PatchAssembly {
                 _ => runs.push((f, f + 1)),
             }
         }
-        let chunk = runs
-            .len()
-            .div_ceil(rayon::current_num_threads().max(1))
-            .max(1);
+        let chunk = runs.len().div_ceil(reduction_parts(runs.len(), 256)).max(1);
         let parts: Vec<[Vec<Real>; N]> = runs
             .par_chunks(chunk)
             .map(|runs| {
@@ -630,7 +627,7 @@ impl PatchAssembly {
             order.push((self.block[f], i));
         }
         order.par_sort_unstable();
-        let chunk = count.div_ceil(rayon::current_num_threads().max(1)).max(1);
+        let chunk = count.div_ceil(reduction_parts(count, 4096)).max(1);
         let parts: Vec<(Vec<Real>, Vec<Point3>, Real)> = order
             .par_chunks(chunk)
             .map(|ids| {

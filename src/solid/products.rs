@@ -5,7 +5,7 @@ use nalgebra::{Cholesky, DMatrix, Dyn};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::math::{Real, Vector3};
+use crate::math::{Real, Vector3, reduction_parts};
 use crate::stencil::StencilTable;
 
 /// `out = T x` for a table `T` and per-column vectors `x` (rows in parallel).
@@ -31,9 +31,7 @@ pub fn mul_transpose_vectors(t: &StencilTable, f: &[Vector3]) -> Vec<Vector3> {
     debug_assert_eq!(f.len(), t.num_rows());
     let n = t.num_cols;
     let rows = t.num_rows();
-    let parts = rayon::current_num_threads()
-        .clamp(1, 8)
-        .min(rows.div_ceil(1024).max(1));
+    let parts = reduction_parts(rows, 1024);
     let size = rows.div_ceil(parts);
     let partial: Vec<Vec<Vector3>> = (0..parts)
         .into_par_iter()

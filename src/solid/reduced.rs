@@ -26,7 +26,7 @@
 use nalgebra::{DMatrix, Matrix3};
 use rayon::prelude::*;
 
-use crate::math::{Point3, Real, Vector3};
+use crate::math::{Point3, Real, Vector3, reduction_parts};
 use crate::stencil::StencilTable;
 
 use super::springs::{SpringHessians, SpringNetwork};
@@ -164,9 +164,7 @@ pub(crate) fn reduced_matrix(
     let blocks = fine_blocks(pattern, inp);
     let n3 = 3 * a1.num_cols;
     let rows = a1.num_rows();
-    let parts = rayon::current_num_threads()
-        .clamp(1, 8)
-        .min(rows.div_ceil(256).max(1));
+    let parts = reduction_parts(rows, 256);
     let size = rows.div_ceil(parts);
     let partial: Vec<Vec<Real>> = (0..parts)
         .into_par_iter()

@@ -22,7 +22,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::lattice::LatticeTopology;
-use crate::math::{Point3, Real, Vector3};
+use crate::math::{Point3, Real, Vector3, reduction_parts};
 
 /// Edge and virtual springs of a lattice, with rest lengths and length scales.
 #[derive(Clone, Debug, Default)]
@@ -125,9 +125,7 @@ fn scatter_sum(
     out: &mut [Vector3],
     body: impl Fn(std::ops::Range<usize>, &mut [Vector3]) -> Real + Sync,
 ) -> Real {
-    let parts = rayon::current_num_threads()
-        .clamp(1, 8)
-        .min(n.div_ceil(2048).max(1));
+    let parts = reduction_parts(n, 2048);
     let size = n.div_ceil(parts);
     let results: Vec<(Vec<Vector3>, Real)> = (0..parts)
         .into_par_iter()
@@ -332,9 +330,7 @@ impl SpringNetwork {
         let (ne, nv) = (self.edges.len(), self.virtuals.len());
         h.edges.resize(ne, [0.0; 5]);
         h.virtuals.resize(nv, [0.0; 5]);
-        let parts = rayon::current_num_threads()
-            .clamp(1, 8)
-            .min((ne + nv).div_ceil(2048).max(1));
+        let parts = reduction_parts(ne + nv, 2048);
         let (ce, cv) = (ne.div_ceil(parts), nv.div_ceil(parts));
         let mut shares = Vec::with_capacity(parts);
         let (mut he, mut hv) = (&mut h.edges[..], &mut h.virtuals[..]);
