@@ -80,6 +80,11 @@ pub struct FitArgs {
     /// across a gap the scan did not see into); 0 turns this off.
     #[arg(long, value_name = "F", default_value_t = FitParams::default().refine_off_data)]
     pub refine_off_data: f64,
+    /// With `--tol-stat p95`, also stop when the 95th percentile is at most
+    /// K times the noise σ estimated from the points (a perfect fit leaves
+    /// 1.96 σ); 0 turns this off.
+    #[arg(long, value_name = "K", default_value_t = FitParams::default().noise_tolerance)]
+    pub noise_tol: f64,
     /// Tension weight λ_t of the thin plate (α = λ_t / area).
     #[arg(long, value_name = "λ", default_value_t = FitParams::default().tension)]
     pub tension: f64,
@@ -146,6 +151,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         },
         refine_significance: args.refine_significance,
         refine_off_data: args.refine_off_data,
+        noise_tolerance: args.noise_tol,
         tension: args.tension,
         bending: args.bending,
         mass: args.mass,

@@ -56,7 +56,7 @@ use super::init::outliers::{Screening, screen};
 use super::quality::assess;
 use super::refine_marks::{faces_above_noise, faces_off_data};
 use super::sampling::{shuffled_order, surface_samples, trimmed_rms};
-use super::{ErrorStats, FitParams, FitReport, LevelReport, Refinement};
+use super::{ErrorStats, FitParams, FitReport, LevelReport, Refinement, ToleranceStat};
 
 /// Iterations of progressive interpolation that put a locally refined
 /// level's surface on its parent's.
@@ -447,6 +447,19 @@ pub fn fit_screened_cloud(
         if error.pct(stat) <= params.tolerance_pct {
             break (true, format!("tolerance met at level {level}"));
         }
+        let noise_pct = 100.0 * data_noise / diameter;
+        if stat == ToleranceStat::P95
+            && noise_pct > 0.0
+            && error.p95_pct <= params.noise_tolerance * noise_pct
+        {
+            break (
+                true,
+                format!(
+                    "the 95th percentile ({:.3} %) is within {} × the estimated noise σ ({:.3} %) at level {level}: a finer level would fit the noise",
+                    error.p95_pct, params.noise_tolerance, noise_pct
+                ),
+            );
+        }
         if level >= params.max_level {
             break (
                 false,
@@ -571,6 +584,7 @@ pub fn fit_screened_cloud(
         control: mesh,
         report: FitReport {
             quality,
+            noise: data_noise,
             points: points.len(),
             outliers,
             diameter,

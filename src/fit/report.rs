@@ -123,6 +123,9 @@ pub struct FitReport {
     pub points: usize,
     /// The data's bounding-box diagonal (the object's diameter).
     pub diameter: Real,
+    /// The estimated noise σ̃ along the normal (length units;
+    /// [`crate::fit::init::outliers::Screening::noise`], 0 when unknown).
+    pub noise: Real,
     /// Points left out of the springs as outliers
     /// ([`FitParams::drop_outliers`](super::FitParams)).
     pub outliers: usize,
