@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 
 use subdyn::mesh::PolyMesh;
-use subdyn::topology::Level;
+use subdyn::topology::{Level, UnionFind};
 
 /// One connected component (faces joined through shared vertices).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -172,41 +172,6 @@ fn edges_with_counts(mesh: &PolyMesh) -> Vec<(u32, u32, usize)> {
         }
     }
     out
-}
-
-/// Disjoint sets with path halving and union by size.
-struct UnionFind {
-    parent: Vec<usize>,
-    size: Vec<usize>,
-}
-
-impl UnionFind {
-    fn new(n: usize) -> Self {
-        UnionFind {
-            parent: (0..n).collect(),
-            size: vec![1; n],
-        }
-    }
-
-    fn find(&mut self, mut x: usize) -> usize {
-        while self.parent[x] != x {
-            self.parent[x] = self.parent[self.parent[x]];
-            x = self.parent[x];
-        }
-        x
-    }
-
-    fn union(&mut self, a: usize, b: usize) {
-        let (mut a, mut b) = (self.find(a), self.find(b));
-        if a == b {
-            return;
-        }
-        if self.size[a] < self.size[b] {
-            std::mem::swap(&mut a, &mut b);
-        }
-        self.parent[b] = a;
-        self.size[a] += self.size[b];
-    }
 }
 
 #[cfg(test)]

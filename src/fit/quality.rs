@@ -28,9 +28,10 @@ use serde::Serialize;
 
 use crate::error::Result;
 use crate::limit::tessellate;
-use crate::math::{Point3, Real};
+use crate::math::{Point3, Real, bounding_box};
 use crate::mesh::PolyMesh;
 use crate::subdivision::{RefineOptions, Refiner};
+use crate::topology::UnionFind;
 
 /// "Far": more than this percentage of the bounding-box diagonal (the
 /// Hausdorff goal of a fit).
@@ -42,9 +43,6 @@ pub const FAR_AREA_FRACTION: Real = 0.002;
 /// Far points are reported above this fraction of the screened points.
 pub const FAR_POINT_FRACTION: Real = 0.001;
 
-/// Folded triangles are reported above this fraction of the triangles.
-pub const FOLD_FRACTION: Real = 0.0;
-
 /// An axis-aligned box (where a finding is).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Region {
@@ -55,17 +53,11 @@ pub struct Region {
 }
 
 impl Region {
-    fn of(points: impl Iterator<Item = Point3>) -> Option<Region> {
-        let mut r: Option<Region> = None;
-        for p in points {
-            let q = [p.x, p.y, p.z];
-            let b = r.get_or_insert(Region { min: q, max: q });
-            for ((lo, hi), x) in b.min.iter_mut().zip(&mut b.max).zip(q) {
-                *lo = lo.min(x);
-                *hi = hi.max(x);
-            }
-        }
-        r
+    fn of(points: &[Point3]) -> Option<Region> {
+        bounding_box(points).map(|(lo, hi)| Region {
+            min: [lo.x, lo.y, lo.z],
+            max: [hi.x, hi.y, hi.z],
+        })
     }
 
     fn describe(&self) -> String {
@@ -145,7 +137,7 @@ pub fn assess(
         far_surface_fraction,
         far_surface_region,
         far_point_fraction,
-        far_point_region: Region::of(far_points.iter().copied()),
+        far_point_region: Region::of(&far_points),
         folded_triangles,
         triangles: tris.len(),
         warnings: Vec::new(),
@@ -166,7 +158,7 @@ pub fn assess(
             q.far_point_region.map_or(String::new(), |r| r.describe())
         ));
     }
-    if q.folded_triangles as Real > FOLD_FRACTION * q.triangles as Real {
+    if q.folded_triangles > 0 {
         q.warnings.push(format!(
             "the limit surface folds over: {} of {} tessellation triangles face against its normals",
             q.folded_triangles, q.triangles
@@ -178,35 +170,22 @@ pub fn assess(
 /// The bounding box of the largest (by triangle count) connected set of
 /// `marked` triangles, triangles connected through shared vertices.
 fn largest_region(tris: &[[u32; 3]], p: &[Point3], marked: &[bool]) -> Option<Region> {
-    let mut parent: Vec<u32> = (0..p.len() as u32).collect();
-    fn root(parent: &mut [u32], mut i: u32) -> u32 {
-        while parent[i as usize] != i {
-            parent[i as usize] = parent[parent[i as usize] as usize];
-            i = parent[i as usize];
-        }
-        i
+    let mut sets = UnionFind::new(p.len());
+    let far = || tris.iter().zip(marked).filter(|(_, m)| **m).map(|(t, _)| t);
+    for t in far() {
+        sets.union(t[0] as usize, t[1] as usize);
+        sets.union(t[0] as usize, t[2] as usize);
     }
-    for (t, _) in tris.iter().zip(marked).filter(|(_, m)| **m) {
-        let r0 = root(&mut parent, t[0]);
-        for &v in &t[1..] {
-            let r = root(&mut parent, v);
-            if r != r0 {
-                parent[r as usize] = r0;
-            }
-        }
-    }
-    let mut count = std::collections::BTreeMap::<u32, usize>::new();
-    for (t, _) in tris.iter().zip(marked).filter(|(_, m)| **m) {
-        *count.entry(root(&mut parent, t[0])).or_default() += 1;
+    let mut count = std::collections::BTreeMap::<usize, usize>::new();
+    for t in far() {
+        *count.entry(sets.find(t[0] as usize)).or_default() += 1;
     }
     let (&best, _) = count
         .iter()
         .max_by_key(|(r, c)| (**c, std::cmp::Reverse(**r)))?;
-    let vertices: Vec<Point3> = tris
-        .iter()
-        .zip(marked)
-        .filter(|(t, m)| **m && root(&mut parent, t[0]) == best)
-        .flat_map(|(t, _)| t.map(|i| p[i as usize]))
+    let vertices: Vec<Point3> = far()
+        .filter(|t| sets.find(t[0] as usize) == best)
+        .flat_map(|t| t.map(|i| p[i as usize]))
         .collect();
-    Region::of(vertices.into_iter())
+    Region::of(&vertices)
 }

@@ -3,6 +3,8 @@
 
 mod level;
 mod sharpness;
+mod union_find;
 
 pub use level::{Level, NONE, VertexRing, face_of_corner};
 pub use sharpness::{SHARPNESS_INFINITE, Sharpness, VertexRule, decrement, find_edge};
+pub use union_find::UnionFind;

@@ -4,7 +4,7 @@
 use crate::error::{Error, Result};
 use crate::math::{Real, Vector3};
 use crate::mesh::PolyMesh;
-use crate::topology::Level;
+use crate::topology::{Level, UnionFind};
 
 /// Topological summary of a manifold mesh.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -25,48 +25,29 @@ pub fn surface_topology(mesh: &PolyMesh) -> Result<SurfaceTopology> {
     let level = Level::from_mesh(mesh)?;
     let nf = level.num_faces();
     // Components by union-find over faces that share an edge.
-    let mut parent: Vec<usize> = (0..nf).collect();
-    fn find(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
+    let mut sets = UnionFind::new(nf);
     let mut boundary_edges = Vec::new();
     for (e, faces) in level.edge_faces.iter().enumerate() {
         if level.is_boundary_edge(e) {
             boundary_edges.push(e);
             continue;
         }
-        let (a, b) = (
-            find(&mut parent, faces[0] as usize),
-            find(&mut parent, faces[1] as usize),
-        );
-        if a != b {
-            parent[a] = b;
-        }
+        sets.union(faces[0] as usize, faces[1] as usize);
     }
-    let components = (0..nf).filter(|&f| find(&mut parent, f) == f).count();
+    let components = (0..nf).filter(|&f| sets.find(f) == f).count();
     // Boundary loops: each boundary vertex of a manifold mesh has exactly two
     // boundary edges, so loops are components of the boundary-edge graph.
     let nv = level.num_vertices;
-    let mut vparent: Vec<usize> = (0..nv).collect();
+    let mut loops = UnionFind::new(nv);
     let mut on_boundary = vec![false; nv];
     for &e in &boundary_edges {
         let [v0, v1] = level.edge_verts[e];
         on_boundary[v0 as usize] = true;
         on_boundary[v1 as usize] = true;
-        let (a, b) = (
-            find(&mut vparent, v0 as usize),
-            find(&mut vparent, v1 as usize),
-        );
-        if a != b {
-            vparent[a] = b;
-        }
+        loops.union(v0 as usize, v1 as usize);
     }
     let boundary_loops = (0..nv)
-        .filter(|&v| on_boundary[v] && find(&mut vparent, v) == v)
+        .filter(|&v| on_boundary[v] && loops.find(v) == v)
         .count();
     let used = (0..nv).filter(|&v| level.valence(v) > 0).count() as i64;
     let euler = used - level.num_edges() as i64 + nf as i64;
