@@ -508,4 +508,5 @@ pub fn run_subdyn(dir: &Path, args: &[&str]) -> std::process::Output {
         .expect("the subdyn binary runs")
 }
 
+pub mod sdf;
 pub mod volume;
