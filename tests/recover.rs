@@ -3,6 +3,8 @@
 
 mod common;
 
+use common::sdf::{sdf_volume, surface_error, write_raw};
+
 use subdyn::fit::recover::{
     RecoverParams, component_cage, prepare_volume, prepare_volume_owned, recover_shape, seed_cage,
 };
@@ -10,37 +12,6 @@ use subdyn::forces::BoundaryModel;
 use subdyn::limit::tessellate;
 use subdyn::math::{Point3, Real};
 use subdyn::subdivision::{RefineOptions, Refiner};
-use subdyn::volume::Volume;
-
-/// A volume of `dims` voxels, spacing `spacing`, whose value at a voxel centre
-/// is `clamp(0.5 − sdf / w, 0, 1)` for a signed distance `sdf` (negative
-/// inside) and a ramp of width `w` (world units): the 0.5 level is the surface.
-fn sdf_volume(dims: [usize; 3], spacing: [Real; 3], sdf: impl Fn(Point3) -> Real) -> Volume {
-    let w = spacing.iter().cloned().fold(0.0, Real::max);
-    let mut data = Vec::with_capacity(dims.iter().product());
-    for k in 0..dims[2] {
-        for j in 0..dims[1] {
-            for i in 0..dims[0] {
-                let p = Point3::new(
-                    i as Real * spacing[0],
-                    j as Real * spacing[1],
-                    k as Real * spacing[2],
-                );
-                data.push((0.5 - sdf(p) / w).clamp(0.0, 1.0) as f32);
-            }
-        }
-    }
-    Volume::new(dims, data, spacing, Point3::origin()).unwrap()
-}
-
-/// Largest and mean |sdf| over a dense limit tessellation of `control`.
-fn surface_error(control: &subdyn::mesh::PolyMesh, sdf: impl Fn(Point3) -> Real) -> (Real, Real) {
-    let refiner = Refiner::new(control, &RefineOptions::default()).unwrap();
-    let (tess, _) = tessellate(&refiner, &control.positions, 4).unwrap();
-    let d: Vec<Real> = tess.positions.iter().map(|p| sdf(*p).abs()).collect();
-    let max = d.iter().cloned().fold(0.0, Real::max);
-    (max, d.iter().sum::<Real>() / d.len() as Real)
-}
 
 #[test]
 fn a_seed_grows_to_a_sphere_iso_surface() {
@@ -98,19 +69,7 @@ fn a_torus_is_recovered_from_its_thresholded_component_with_edges() {
         out.report.stop_reason
     );
     assert!(mean < 0.3 && max < 1.5, "mean {mean} max {max}");
-}
-
-/// Writes `vol` as `dir/NAME.raw` (f32 little-endian) with its JSON header.
-fn write_raw(dir: &std::path::Path, name: &str, vol: &Volume) -> std::path::PathBuf {
-    let bytes: Vec<u8> = vol.data().iter().flat_map(|v| v.to_le_bytes()).collect();
-    std::fs::write(dir.join(format!("{name}.raw")), bytes).unwrap();
-    let o = vol.origin();
-    let header = serde_json::json!({
-        "dims": vol.dims(), "spacing": vol.spacing(), "origin": [o.x, o.y, o.z],
-        "dtype": "f32", "byte_order": "little", "header_bytes": 0,
-    });
-    std::fs::write(dir.join(format!("{name}.json")), header.to_string()).unwrap();
-    dir.join(format!("{name}.raw"))
+    assert!(subdyn::fit::recover::poor_result(&out.report, &params).is_empty());
 }
 
 #[test]

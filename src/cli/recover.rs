@@ -9,8 +9,8 @@ use clap::Args;
 use serde_json::json;
 
 use subdyn::fit::recover::{
-    PreparedVolume, RecoverParams, RecoverReport, component_cage, prepare_volume_owned,
-    recover_shape, seed_cage,
+    BONE_HU, PreparedVolume, RecoverParams, RecoverReport, SKIN_HU, component_cage, poor_result,
+    prepare_volume_owned, recover_shape, seed_cage,
 };
 use subdyn::forces::BoundaryModel;
 use subdyn::io::{VolumeFile, VolumeReadOptions, read_points, read_volume, write_mesh};
@@ -50,10 +50,16 @@ pub struct RecoverArgs {
     #[arg(long, value_name = "MESH", conflicts_with = "auto")]
     pub init: Option<PathBuf>,
     /// The boundary is the level set at this intensity (e.g. CT Hounsfield
-    /// units, 0.5 of a probability map). Without it the boundary is the
-    /// strongest nearby edge of the smoothed image.
-    #[arg(long, value_name = "T")]
+    /// units, negative ones too: --iso -300; 0.5 of a probability map).
+    /// Without it (or --preset) the boundary is the strongest nearby edge of
+    /// the smoothed image.
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
     pub iso: Option<f64>,
+    /// A CT iso-value in Hounsfield units (NIfTI scl_slope / scl_inter are
+    /// applied on reading): skin = -500 HU (half-way from air, -1000, to soft
+    /// tissue, 0), bone = +300 HU (above soft tissue, below cortical bone).
+    #[arg(long, value_enum, conflicts_with = "iso")]
+    pub preset: Option<CtPreset>,
     /// Weakest edge accepted without --iso, as a fraction of the volume's strongest.
     #[arg(long, value_name = "F", default_value_t = 0.1)]
     pub edge_strength: f64,
@@ -107,9 +113,34 @@ pub struct RecoverArgs {
     /// (blue) over the image to this directory: three z slices, one y, one x.
     #[arg(long, value_name = "DIR")]
     pub slices_png: Option<PathBuf>,
+    /// Write the result even when it is poor: its surface leaves the
+    /// volume's box, too much of it found no boundary ("unresolved"), or a
+    /// finer level followed the image worse than its parent. Without it such
+    /// a result is an error and nothing is written.
+    #[arg(long)]
+    pub accept_poor: bool,
     /// No progress display.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// CT presets of `--preset`: iso-values in Hounsfield units.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum CtPreset {
+    /// The skin: -500 HU ([`SKIN_HU`]).
+    Skin,
+    /// Bone: +300 HU ([`BONE_HU`]).
+    Bone,
+}
+
+impl CtPreset {
+    /// The iso-value in Hounsfield units.
+    fn hounsfield(self) -> f64 {
+        match self {
+            CtPreset::Skin => SKIN_HU,
+            CtPreset::Bone => BONE_HU,
+        }
+    }
 }
 
 fn parse_triple(s: &str) -> Result<[f64; 3], String> {
@@ -141,7 +172,7 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
         anyhow::bail!("--tess {} is out of range: expected 1 to 64", args.tess);
     }
     let params = RecoverParams {
-        boundary: match args.iso {
+        boundary: match args.iso.or(args.preset.map(CtPreset::hounsfield)) {
             Some(value) => BoundaryModel::Iso { value },
             None => BoundaryModel::Edge {
                 min_strength: args.edge_strength,
@@ -200,6 +231,23 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     let result = result.map_err(|e| {
         anyhow::Error::new(e).context(format!("recovering from {}", args.input.display()))
     })?;
+    let problems = poor_result(&result.report, &params);
+    if !problems.is_empty() && !args.accept_poor {
+        drop(progress);
+        print_stdout(&summary(
+            args,
+            &notes,
+            read_s,
+            init_s,
+            &result.report,
+            false,
+        ))?;
+        anyhow::bail!(
+            "poor result from {}, nothing written: {}; --accept-poor writes it anyway",
+            args.input.display(),
+            problems.join("; ")
+        );
+    }
     let memory = StagePeaks {
         volume_bytes,
         stages: vec![
@@ -231,15 +279,21 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     }
     drop(progress);
     if let Some(path) = &args.report {
+        // The input's grid: the smoothed volume carries one more sample on
+        // every side (the padding that closes objects cut by the box).
         let grid = &prepared.smoothed;
+        let pad = PreparedVolume::PADDING;
+        let origin = grid.world([pad as f64; 3]);
         let value = json!({
             "command": "recover",
             "input": args.input.display().to_string(),
             "format": source,
             "notes": notes,
-            "dims": grid.dims(),
+            "dims": grid.dims().map(|d| d - 2 * pad),
             "spacing": grid.spacing(),
-            "origin": [grid.origin().x, grid.origin().y, grid.origin().z],
+            "origin": [origin.x, origin.y, origin.z],
+            "padding": pad,
+            "poor_result": problems,
             "output": args.output.display().to_string(),
             "limit_out": args.limit_out.as_ref().map(|p| p.display().to_string()),
             "init": init_json,
@@ -257,7 +311,10 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
         });
         write_report(path, &value)?;
     }
-    let mut text = summary(args, &notes, read_s, init_s, &result.report);
+    let mut text = summary(args, &notes, read_s, init_s, &result.report, true);
+    for p in &problems {
+        text.push_str(&format!("poor result accepted (--accept-poor): {p}\n"));
+    }
     text.push_str(&memory.line());
     if !slice_files.is_empty() {
         text.push_str(&format!(
@@ -406,6 +463,7 @@ fn summary(
     read_s: f64,
     init_s: f64,
     r: &RecoverReport,
+    written: bool,
 ) -> String {
     let mut s = format!(
         "recovered {} in {:.2} s: {}\n",
@@ -437,10 +495,15 @@ fn summary(
             100.0 * l.unresolved
         ));
     }
-    s.push_str(&format!("wrote {}", args.output.display()));
-    if let Some(p) = &args.limit_out {
-        s.push_str(&format!(" and {}", p.display()));
+    s.push_str(
+        "(offsets: surface to the boundary found along its normal; unresolved: share of the surface that found no boundary within the search range along its normal (± a third of the mean control edge, 2 to 12 voxels), so the thin plate, not the image, placed it)\n",
+    );
+    if written {
+        s.push_str(&format!("wrote {}", args.output.display()));
+        if let Some(p) = &args.limit_out {
+            s.push_str(&format!(" and {}", p.display()));
+        }
+        s.push('\n');
     }
-    s.push('\n');
     s
 }

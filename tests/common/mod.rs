@@ -545,4 +545,5 @@ pub fn assert_clean_failure(
     assert_eq!(files(dir), expected, "files left behind");
 }
 
+pub mod sdf;
 pub mod volume;

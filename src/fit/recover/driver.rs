@@ -71,6 +71,7 @@ pub fn recover_shape(
     let mut levels: Vec<RecoverLevel> = Vec::new();
     // The previous level's result, returned if the next one is worse.
     let mut coarser: Option<PolyMesh> = None;
+    let mut dropped = false;
     let (converged, stop_reason) = loop {
         let level = levels.len();
         let level_start = Instant::now();
@@ -133,7 +134,7 @@ pub fn recover_shape(
         let mut p = mesh.positions.clone();
         let mut energy: Vec<Real> = Vec::new();
         let (mut steps, mut cg_iterations, mut still) = (0, 0, false);
-        let (offsets, unresolved, search) = loop {
+        let (offsets, unresolved, search, outside_box) = loop {
             let search = search_of(&p);
             let range = search * voxel;
             let xs = j.apply(&p)?;
@@ -168,7 +169,11 @@ pub fn recover_shape(
                     "the model's limit surface has no area; is the initial mesh degenerate?".into(),
                 ));
             }
-            let outside = xs.iter().filter(|x| !field.smoothed.contains(x)).count();
+            let beyond: Vec<Real> = xs
+                .iter()
+                .map(|x| voxels_outside_box(field.smoothed, x))
+                .collect();
+            let outside = beyond.iter().filter(|&&b| b > 0.0).count();
             if 2 * outside > xs.len() {
                 return Err(Error::NotConverged(format!(
                     "the model left the volume at level {level}, step {steps}: start from a finer cage (--resolution) or a seed inside the object"
@@ -213,7 +218,10 @@ pub fn recover_shape(
                             || change <= 0.5 * (params.settle_voxels * voxel).powi(2)
                     }));
             energy.push(e);
-            if settled || steps >= max_steps {
+            // A sample farther outside the box than it searches cannot be on
+            // its way to a boundary inside it: the level has gone wrong.
+            let escaped = beyond.iter().any(|&b| b > search + 1.0);
+            if settled || escaped || steps >= max_steps {
                 let t: Vec<Real> = found
                     .iter()
                     .filter_map(|f| match f.2 {
@@ -222,10 +230,13 @@ pub fn recover_shape(
                     })
                     .collect();
                 let unresolved = 1.0 - t.len() as Real / found.len() as Real;
+                let outside_box = beyond.iter().filter(|&&b| b > 1.0).count() as Real
+                    / beyond.len().max(1) as Real;
                 break (
                     ErrorStats::new(&t, bbox_diagonal(&xs) / voxel),
                     unresolved,
                     search,
+                    outside_box,
                 );
             }
             let a = kd.linear_combination(1.0, &springs.matrix, 1.0)?;
@@ -266,6 +277,7 @@ pub fn recover_shape(
             offsets,
             unresolved,
             search_voxels: search,
+            outside_box,
         });
         // A finer level that follows the image worse than its parent on
         // every count (a thin structure can pull the finer surface's
@@ -284,7 +296,28 @@ pub fn recover_shape(
                 level - 1
             );
             mesh = parent.clone();
+            dropped = true;
             break (false, reason);
+        }
+        if outside_box > 0.0 {
+            break (
+                false,
+                format!(
+                    "the surface left the volume's box at level {level}: {:.0} of its {} samples lie more than 1 voxel outside",
+                    outside_box * q.weights.len() as Real,
+                    q.weights.len()
+                ),
+            );
+        }
+        if unresolved > params.max_unresolved {
+            break (
+                false,
+                format!(
+                    "{:.1} % of the surface found no boundary within ±{search:.1} voxels at level {level} (more than {:.0} %): finer levels would not find it",
+                    100.0 * unresolved,
+                    100.0 * params.max_unresolved
+                ),
+            );
         }
         if offsets.p95 <= params.tolerance_voxels && unresolved < 0.01 {
             break (true, format!("tolerance met at level {level}"));
@@ -323,9 +356,11 @@ pub fn recover_shape(
         let p1 = h.stencil(0).apply(&mesh.positions)?;
         coarser = Some(std::mem::replace(&mut mesh, h.mesh(1, p1)));
     };
+    let returned_level = levels.len().saturating_sub(1 + usize::from(dropped));
     Ok(RecoverResult {
         control: mesh,
         report: RecoverReport {
+            returned_level,
             voxel,
             sigma: prepared.sigma,
             inside_level: prepared.inside_level,
@@ -339,6 +374,16 @@ pub fn recover_shape(
                 + prepared.potential_seconds,
         },
     })
+}
+
+/// How far `x` lies outside `volume`'s sample box (`0 ≤ index ≤ n − 1`),
+/// in index units (voxels along the farthest axis); 0 inside.
+fn voxels_outside_box(volume: &crate::volume::Volume, x: &Point3) -> Real {
+    let c = volume.continuous_index(x);
+    let dims = volume.dims();
+    (0..3)
+        .map(|a| (-c[a]).max(c[a] - (dims[a] - 1) as Real))
+        .fold(0.0, Real::max)
 }
 
 /// Mean length of the control mesh's edges at positions `p` (each face side

@@ -4,12 +4,16 @@
 
 mod driver;
 mod init;
+mod pad;
 mod params;
 mod prepare;
+mod quality;
 mod report;
 
 pub use driver::{RecoverResult, recover_shape};
 pub use init::{ComponentCage, component_cage, seed_cage};
-pub use params::RecoverParams;
+pub use pad::padded_at_level;
+pub use params::{BONE_HU, RecoverParams, SKIN_HU};
 pub use prepare::{PreparedVolume, prepare_volume, prepare_volume_owned};
+pub use quality::poor_result;
 pub use report::{RecoverLevel, RecoverReport};

@@ -4,6 +4,28 @@ use crate::error::{Error, Result};
 use crate::forces::BoundaryModel;
 use crate::math::Real;
 
+/// Iso-value of the skin in CT, Hounsfield units (`--preset skin`): −500 HU.
+///
+/// On the Hounsfield scale air is −1000 HU and water 0 HU by definition;
+/// skin and the soft tissue under it lie near 0 (fat −100). The level
+/// half-way across a blurred step edge sits on the edge itself, so the
+/// half-way level between air and soft tissue, −500 HU, puts the surface
+/// on the skin whatever the scanner's blur. It lies inside the "Skin Tissue
+/// (Adult)" threshold range of InVesalius's CT presets (−718 to −177 HU,
+/// `invesalius/presets.py`, values from Materialise Mimics) and stays clear
+/// of noise in the air around the head (tens of HU).
+pub const SKIN_HU: Real = -500.0;
+
+/// Iso-value of bone in CT, Hounsfield units (`--preset bone`): +300 HU.
+///
+/// Soft tissue and unenhanced blood are below about +100 HU; cortical bone
+/// is +700 to +2000 HU and the skull's spongy bone +150 to +650
+/// (InVesalius's CT presets: "Bone" from +226 HU, "Spongial Bone (Adult)"
+/// +148 to +661). +300 HU is above soft tissue and most contrast-enhanced
+/// vessels, below thin cortical bone whose value partial volume lowers, and
+/// near the half-way level between soft tissue and spongy bone.
+pub const BONE_HU: Real = 300.0;
+
 /// Options of the volume recovery. Lengths in voxels are multiples of the
 /// volume's smallest spacing.
 #[derive(Clone, Debug, PartialEq)]
@@ -60,6 +82,12 @@ pub struct RecoverParams {
     /// surface) relative to the image springs, whose stiffness sums to 1
     /// (default 1; only used when points are given).
     pub points_weight: Real,
+    /// Largest fraction of the surface allowed to find no boundary within
+    /// its search range (default 0.1). A level above it ends the recovery
+    /// (finer levels leave such samples to the thin plate, so they would
+    /// not find it either), and [`poor_result`](super::poor_result) calls
+    /// the result poor.
+    pub max_unresolved: Real,
 }
 
 impl Default for RecoverParams {
@@ -82,6 +110,7 @@ impl Default for RecoverParams {
             inflation: 0.0,
             quadrature_order: 3,
             points_weight: 1.0,
+            max_unresolved: 0.1,
         }
     }
 }
@@ -145,6 +174,12 @@ impl RecoverParams {
         non_negative("bending", self.bending)?;
         positive("damping", self.damping)?;
         non_negative("points weight", self.points_weight)?;
+        if !(0.0..=1.0).contains(&self.max_unresolved) {
+            return Err(Error::Input(format!(
+                "max unresolved {} must be a fraction in [0, 1]",
+                self.max_unresolved
+            )));
+        }
         if !self.inflation.is_finite() {
             return Err(Error::Input("inflation must be finite".into()));
         }

@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use super::RecoverParams;
+use super::{RecoverParams, padded_at_level};
 use crate::error::{Error, Result};
 use crate::forces::BoundaryModel;
 use crate::math::Real;
@@ -12,10 +12,13 @@ use crate::volume::{
     Volume, edge_potential, gaussian_smoothed, gaussian_smoothed_owned, otsu_threshold,
 };
 
-/// A volume ready for recovery: smoothed, with its edge potential.
+/// A volume ready for recovery: smoothed, padded, with its edge potential.
 #[derive(Clone, Debug)]
 pub struct PreparedVolume {
-    /// `G_σ * I`.
+    /// `G_σ * I`, with one layer of outside samples on every side
+    /// ([`padded_at_level`](super::padded_at_level)) so that an object cut
+    /// by the box closes on its faces: its grid is the input's with
+    /// [`PreparedVolume::PADDING`] more samples before and after each axis.
     pub smoothed: Volume,
     /// The edge potential (for [`BoundaryModel::Edge`]).
     pub potential: Option<Volume>,
@@ -28,6 +31,11 @@ pub struct PreparedVolume {
     pub smoothing_seconds: Real,
     /// Seconds spent on the potential.
     pub potential_seconds: Real,
+}
+
+impl PreparedVolume {
+    /// Samples added before and after each axis of the input's grid.
+    pub const PADDING: usize = 1;
 }
 
 /// The precompute step: smoothing, edge potential and inside level.
@@ -77,7 +85,7 @@ fn checked_sigma(volume: &Volume, params: &RecoverParams) -> Result<Real> {
     ))
 }
 
-/// The potential and inside level of the smoothed volume.
+/// The inside level of the smoothed volume, the padding and the potential.
 fn finished(
     smoothed: Volume,
     sigma: Real,
@@ -85,12 +93,14 @@ fn finished(
     params: &RecoverParams,
 ) -> Result<PreparedVolume> {
     let t = Instant::now();
-    let (potential, inside_level) = match params.boundary {
-        BoundaryModel::Iso { value } => (None, value),
-        BoundaryModel::Edge { .. } => (
-            Some(edge_potential(&smoothed)?),
-            otsu_threshold(&smoothed)? as Real,
-        ),
+    let inside_level = match params.boundary {
+        BoundaryModel::Iso { value } => value,
+        BoundaryModel::Edge { .. } => otsu_threshold(&smoothed)? as Real,
+    };
+    let smoothed = padded_at_level(&smoothed, inside_level, params.bright_inside)?;
+    let potential = match params.boundary {
+        BoundaryModel::Iso { .. } => None,
+        BoundaryModel::Edge { .. } => Some(edge_potential(&smoothed)?),
     };
     Ok(PreparedVolume {
         smoothed,

@@ -31,6 +31,9 @@ pub struct RecoverLevel {
     pub unresolved: Real,
     /// Search half-length used, in voxels.
     pub search_voxels: Real,
+    /// Fraction of samples more than 1 voxel outside the volume's sample
+    /// box (the padded box, so a surface closed on the box faces is inside).
+    pub outside_box: Real,
 }
 
 /// The whole recovery.
@@ -46,8 +49,10 @@ pub struct RecoverReport {
     pub smoothing_seconds: Real,
     /// Seconds spent on the edge potential (0 for an iso-surface).
     pub potential_seconds: Real,
-    /// Per level.
+    /// Per level (a level worse than its parent is listed, then dropped).
     pub levels: Vec<RecoverLevel>,
+    /// Index in `levels` of the level whose control mesh is returned.
+    pub returned_level: usize,
     /// Whether the tolerance was met.
     pub converged: bool,
     /// Why the recovery stopped.

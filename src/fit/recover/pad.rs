@@ -1,0 +1,62 @@
+//! Closing objects cut by the volume's box: one layer of "outside" samples
+//! around the grid, placed so the iso-surface closes on the box faces.
+
+use crate::error::Result;
+use crate::math::Real;
+use crate::volume::Volume;
+
+/// `volume` with one more sample on every side of every axis (dims `n + 2`,
+/// the origin moved one step back along each index axis), so that an object
+/// cut by the box closes there, as marching cubes on a padded volume does.
+///
+/// A pad sample next to a border sample `v` is `min(v, 2L − v)` for a bright
+/// object (`max` for a dark one), `L` the inside level: a border sample
+/// outside the object is copied (the clamped extension the samplers use, so
+/// nothing changes where the object does not touch the box), and one inside
+/// is mirrored about `L`. The trilinear interpolant between `v` and its pad
+/// `2L − v` crosses `L` half-way, so the cap lies on the box face itself, half a
+/// voxel beyond the outermost sample centres (index `−½` and `n − ½`), whatever
+/// the contrast. Pad samples touching several faces take the mirror of the
+/// nearest border sample (the index clamped to the grid).
+pub fn padded_at_level(volume: &Volume, level: Real, bright_inside: bool) -> Result<Volume> {
+    let [nx, ny, nz] = volume.dims();
+    let dims = [nx + 2, ny + 2, nz + 2];
+    let data = volume.data();
+    let outside = |v: f32| -> f32 {
+        let mirrored = (2.0 * level - v as Real) as f32;
+        if bright_inside {
+            v.min(mirrored)
+        } else {
+            v.max(mirrored)
+        }
+    };
+    let mut out = Vec::with_capacity(dims[0] * dims[1] * dims[2]);
+    for k in 0..dims[2] {
+        let (kk, kb) = clamped(k, nz);
+        for j in 0..dims[1] {
+            let (jj, jb) = clamped(j, ny);
+            let row = nx * (jj + ny * kk);
+            if !(kb || jb) {
+                out.push(outside(data[row]));
+                out.extend_from_slice(&data[row..row + nx]);
+                out.push(outside(data[row + nx - 1]));
+            } else {
+                out.extend((0..dims[0]).map(|i| outside(data[row + clamped(i, nx).0])));
+            }
+        }
+    }
+    let origin = volume.world([-1.0, -1.0, -1.0]);
+    Volume::with_affine(dims, out, *volume.linear(), origin)
+}
+
+/// The original index of padded index `i` on an axis of `n` samples, clamped
+/// to the grid, and whether `i` is a pad sample.
+fn clamped(i: usize, n: usize) -> (usize, bool) {
+    if i == 0 {
+        (0, true)
+    } else if i > n {
+        (n - 1, true)
+    } else {
+        (i - 1, false)
+    }
+}
