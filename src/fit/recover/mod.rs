@@ -7,9 +7,11 @@ mod init;
 mod params;
 mod prepare;
 mod report;
+mod start;
 
 pub use driver::{RecoverResult, recover_shape};
 pub use init::{ComponentCage, component_cage, seed_cage};
 pub use params::RecoverParams;
 pub use prepare::{PreparedVolume, prepare_volume, prepare_volume_owned};
 pub use report::{RecoverLevel, RecoverReport};
+pub use start::{RecoverStart, initial_model};
