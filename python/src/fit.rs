@@ -15,7 +15,7 @@ use subdyn::mesh::{PointCloud, PolyMesh};
 
 use crate::arrays::{mesh, mesh_arrays, points, value_error, vector_array, vectors, without_gil};
 use crate::options::Options;
-use crate::surface::limit_tessellation;
+use subdyn::limit::limit_surface_mesh;
 
 /// The options of `fit` (the CLI's flags that describe the work).
 const FIT_OPTIONS: &[&str] = &[
@@ -76,7 +76,9 @@ pub fn fit<'py>(
         Some((v, fv, fo)) => FitStart::Mesh(mesh(v, fv, fo)?),
         None => {
             let method = o.string("init", "auto")?;
-            let kind = method.parse::<InitKind>().map_err(|e| value_error(e.to_string()))?;
+            let kind = method
+                .parse::<InitKind>()
+                .map_err(|e| value_error(e.to_string()))?;
             FitStart::Method(InitParams {
                 kind,
                 resolution: o.usize("init_resolution", InitParams::default().resolution)?,
@@ -86,7 +88,7 @@ pub fn fit<'py>(
     };
     let (run, limit, report) = without_gil(py, threads, || {
         let run = fit_from_start(&cloud, &start, &params, &mut |_, _, _| {})?;
-        let limit = limit_tessellation(&run.result.control, &Default::default(), tess, quads)?;
+        let limit = limit_surface_mesh(&run.result.control, &Default::default(), tess, quads)?;
         let mut report = json!({
             "command": "fit",
             "input": format!("an array of {n} points"),

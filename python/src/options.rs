@@ -64,9 +64,7 @@ impl<'a, 'py> Options<'a, 'py> {
 
     /// A non-negative integer, or `default`.
     pub fn usize(&self, name: &str, default: usize) -> PyResult<usize> {
-        Ok(self
-            .get(name, "a non-negative integer")?
-            .unwrap_or(default))
+        Ok(self.get(name, "a non-negative integer")?.unwrap_or(default))
     }
 
     /// An optional non-negative integer.

@@ -18,7 +18,7 @@ use subdyn::volume::Volume;
 use crate::arrays::{mesh, points, value_error, without_gil};
 use crate::fit::result_dict;
 use crate::options::Options;
-use crate::surface::limit_tessellation;
+use subdyn::limit::limit_surface_mesh;
 
 /// The options of `recover` (the CLI's flags that describe the work).
 const RECOVER_OPTIONS: &[&str] = &[
@@ -111,7 +111,7 @@ pub fn recover<'py>(
         let (init, init_json) = initial_model(&prepared, &start, !dark)?;
         let init_s = t.elapsed().as_secs_f64();
         let result = recover_shape(&prepared, &init, &points, &params, &mut |_, _, _| {})?;
-        let limit = limit_tessellation(&result.control, &Default::default(), tess, quads)?;
+        let limit = limit_surface_mesh(&result.control, &Default::default(), tess, quads)?;
         let grid = &prepared.smoothed;
         let report = json!({
             "command": "recover",

@@ -1,17 +1,19 @@
 //! `subdivide` and `LimitSurface`: uniform refinement, exact limit
 //! evaluation and limit-stencil Jacobians of a control mesh.
 
-use numpy::{PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use numpy::ndarray::Array3;
+use numpy::{PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
-use subdyn::limit::{LimitEvaluator, Sample, tessellate};
-use subdyn::math::{Point3, Vector3};
+use subdyn::limit::{LimitEvaluator, Sample, limit_surface_mesh};
+use subdyn::math::Point3;
 use subdyn::mesh::{PolyMesh, split_quads};
 use subdyn::subdivision::{RefineOptions, Refiner, check_uniform_size, uniform_positions};
 
-use crate::arrays::{MeshArrays, mesh, mesh_arrays, py_err, value_error, vector_array, without_gil};
+use crate::arrays::{
+    MeshArrays, mesh, mesh_arrays, py_err, value_error, vector_array, without_gil,
+};
 
 /// Refinement options from the `creases` array (rows `i j s`) and the
 /// boundary rule's CLI spelling (`edge-and-corner`, `edge-only`).
@@ -45,19 +47,6 @@ pub fn refine_options(
     })
 }
 
-/// The limit surface of `control` tessellated `k × k` per quad with its unit
-/// normals, as triangles unless `quads` (as `subdyn fit --limit-out`).
-pub fn limit_tessellation(
-    control: &PolyMesh,
-    options: &RefineOptions,
-    k: usize,
-    quads: bool,
-) -> subdyn::Result<(PolyMesh, Vec<Vector3>)> {
-    let refiner = Refiner::new(control, options)?;
-    let (surf, normals) = tessellate(&refiner, &control.positions, k)?;
-    Ok((if quads { surf } else { split_quads(&surf) }, normals))
-}
-
 /// Uniform Catmull-Clark refinement to `levels` (at most 8); with `limit`
 /// the vertices are moved to the limit surface and the faces are triangles
 /// unless `quads` (as `subdyn subdivide`).
@@ -82,7 +71,11 @@ pub fn subdivide<'py>(
         let h = Refiner::new(&m, &options)?.refine_uniform(levels)?;
         let p = uniform_positions(&h, &m.positions, levels, limit)?;
         let out = h.mesh(levels, p);
-        Ok(if limit && !quads { split_quads(&out) } else { out })
+        Ok(if limit && !quads {
+            split_quads(&out)
+        } else {
+            out
+        })
     })?;
     Ok(mesh_arrays(py, &out))
 }
@@ -218,7 +211,7 @@ impl LimitSurface {
         quads: bool,
     ) -> PyResult<Bound<'py, PyTuple>> {
         let (surf, normals) = without_gil(py, None, || {
-            limit_tessellation(&self.mesh, &self.options, k, quads)
+            limit_surface_mesh(&self.mesh, &self.options, k, quads)
         })?;
         let (v, fv, fo) = mesh_arrays(py, &surf);
         (v, fv, fo, vector_array(py, &normals)).into_pyobject(py)

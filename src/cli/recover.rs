@@ -9,8 +9,7 @@ use clap::Args;
 use serde_json::json;
 
 use subdyn::fit::recover::{
-    PreparedVolume, RecoverParams, RecoverReport, RecoverStart, prepare_volume_owned,
-    recover_shape,
+    PreparedVolume, RecoverParams, RecoverReport, RecoverStart, prepare_volume_owned, recover_shape,
 };
 use subdyn::forces::BoundaryModel;
 use subdyn::io::{VolumeFile, VolumeReadOptions, read_points, read_volume, write_mesh};
