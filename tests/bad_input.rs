@@ -339,7 +339,7 @@ fn work_over_the_memory_budget_is_refused_with_the_estimate() {
             "-o",
             "o.obj",
         ],
-        &["8 levels of cube.obj", "needs about", "--max-memory"],
+        &["cube.obj", "8 levels", "needs about", "--max-memory"],
         &inputs,
     );
     refused(

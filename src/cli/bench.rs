@@ -120,7 +120,7 @@ fn bench_subdivide(args: &BenchSubdivideArgs) -> anyhow::Result<()> {
             thousands(MAX_FACES)
         );
     }
-    super::subdivide::check_refinement_memory(
+    subdyn::subdivision::check_refinement_memory(
         faces,
         false,
         &format!("--grid {} --levels {}", args.grid, args.levels),

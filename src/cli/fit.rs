@@ -10,7 +10,7 @@ use serde_json::json;
 use subdyn::fit::init::InitParams;
 use subdyn::fit::{FitParams, FitReport, FitStart, Refinement, ToleranceStat, fit_from_start};
 use subdyn::io::{read_points, write_mesh};
-use subdyn::limit::tessellate;
+use subdyn::limit::limit_surface_mesh;
 use subdyn::subdivision::{RefineOptions, Refiner};
 
 use super::common::{
@@ -185,10 +185,13 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     progress.stage(format!("writing {}", args.output.display()));
     write_mesh(&args.output, &result.control, None).map_err(|e| about_file(e, &args.output))?;
     if let Some(path) = &args.limit_out {
-        let refiner = Refiner::new(&result.control, &RefineOptions::default())?;
-        let (surf, normals) = tessellate(&refiner, &result.control.positions, args.tess)?;
-        write_mesh(path, &args.faces.mesh(&surf), Some(&normals))
-            .map_err(|e| about_file(e, path))?;
+        let (surf, normals) = limit_surface_mesh(
+            &result.control,
+            &RefineOptions::default(),
+            args.tess,
+            args.faces.quads,
+        )?;
+        write_mesh(path, &surf, Some(&normals)).map_err(|e| about_file(e, path))?;
     }
     if let Some(path) = &args.plot {
         write_plot(path, &result.report)?;

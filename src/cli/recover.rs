@@ -9,8 +9,8 @@ use clap::Args;
 use serde_json::json;
 
 use subdyn::fit::recover::{
-    BONE_HU, PreparedVolume, RecoverParams, RecoverReport, SKIN_HU, component_cage, poor_result,
-    prepare_volume_owned, recover_shape, seed_cage,
+    BONE_HU, PreparedVolume, RecoverParams, RecoverReport, RecoverStart, SKIN_HU, poor_result,
+    prepare_volume_owned, recover_shape,
 };
 use subdyn::forces::BoundaryModel;
 use subdyn::io::{VolumeFile, VolumeReadOptions, read_points, read_volume, write_mesh};
@@ -279,20 +279,16 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     }
     drop(progress);
     if let Some(path) = &args.report {
-        // The input's grid: the smoothed volume carries one more sample on
-        // every side (the padding that closes objects cut by the box).
-        let grid = &prepared.smoothed;
-        let pad = PreparedVolume::PADDING;
-        let origin = grid.world([pad as f64; 3]);
+        let (dims, origin) = prepared.input_grid();
         let value = json!({
             "command": "recover",
             "input": args.input.display().to_string(),
             "format": source,
             "notes": notes,
-            "dims": grid.dims().map(|d| d - 2 * pad),
-            "spacing": grid.spacing(),
+            "dims": dims,
+            "spacing": prepared.smoothed.spacing(),
             "origin": [origin.x, origin.y, origin.z],
-            "padding": pad,
+            "padding": PreparedVolume::PADDING,
             "poor_result": problems,
             "output": args.output.display().to_string(),
             "limit_out": args.limit_out.as_ref().map(|p| p.display().to_string()),
@@ -333,72 +329,41 @@ fn initial_model(
     args: &RecoverArgs,
     prepared: &PreparedVolume,
 ) -> anyhow::Result<(PolyMesh, serde_json::Value)> {
-    let volume = &prepared.smoothed;
-    if let Some(s) = args.seed.filter(|_| !args.auto) {
-        let p = Point3::new(s[0], s[1], s[2]);
-        if !volume.contains(&p) {
-            let (lo, hi) = volume.world_bounds();
-            anyhow::bail!(
-                "--seed ({}, {}, {}) lies outside the volume, which spans ({:.2}, {:.2}, {:.2}) to ({:.2}, {:.2}, {:.2})",
-                s[0],
-                s[1],
-                s[2],
-                lo.x,
-                lo.y,
-                lo.z,
-                hi.x,
-                hi.y,
-                hi.z
-            );
-        }
-        let v = volume.sample(&p);
-        let inside = if args.dark {
-            v < prepared.inside_level
-        } else {
-            v > prepared.inside_level
-        };
-        if !inside {
-            anyhow::bail!(
-                "--seed ({}, {}, {}) is not inside the object: the smoothed intensity there is {v:.4}, {} the inside level {:.4}",
-                s[0],
-                s[1],
-                s[2],
-                if args.dark { "not below" } else { "not above" },
-                prepared.inside_level
-            );
-        }
-        if !(args.seed_radius.is_finite() && args.seed_radius > 0.0) {
-            anyhow::bail!("--seed-radius {} must be positive", args.seed_radius);
-        }
-        let mesh = seed_cage(p, args.seed_radius * volume.voxel_size())?;
-        let value = json!({"method": "seed", "seed": s, "radius_voxels": args.seed_radius,
-            "vertices": mesh.num_vertices(), "faces": mesh.num_faces()});
-        return Ok((mesh, value));
-    }
-    if let Some(path) = &args.init {
-        let mesh = read_polygon_mesh(path, args.quiet)?;
-        let value = json!({"method": "file", "path": path.display().to_string(),
-            "vertices": mesh.num_vertices(), "faces": mesh.num_faces()});
-        return Ok((mesh, value));
-    }
-    if !(2..=128).contains(&args.resolution) {
-        anyhow::bail!(
-            "--resolution {} is out of range: expected 2 to 128",
-            args.resolution
-        );
-    }
     let seed = args.seed.map(|s| Point3::new(s[0], s[1], s[2]));
-    let cage = component_cage(
-        volume,
-        prepared.inside_level,
-        !args.dark,
-        seed,
-        args.resolution,
-    )?;
-    let value = json!({"method": "auto", "component_voxels": cage.voxels,
-        "components": cage.components, "block_voxels": cage.block, "genus": cage.genus,
-        "vertices": cage.mesh.num_vertices(), "faces": cage.mesh.num_faces()});
-    Ok((cage.mesh, value))
+    let start = match (&args.init, seed) {
+        (Some(path), _) => RecoverStart::Mesh(read_polygon_mesh(path, args.quiet)?),
+        (None, Some(point)) if !args.auto => RecoverStart::Seed {
+            point,
+            radius_voxels: args.seed_radius,
+        },
+        _ => RecoverStart::Auto {
+            seed,
+            resolution: args.resolution,
+        },
+    };
+    let (mesh, mut value) = subdyn::fit::recover::initial_model(prepared, &start, !args.dark)
+        .map_err(|e| match cli_wording(&e.to_string()) {
+            Some(line) => anyhow::anyhow!(line),
+            None => anyhow::Error::new(e),
+        })?;
+    if let Some(path) = &args.init {
+        value["method"] = json!("file");
+        value["path"] = json!(path.display().to_string());
+    }
+    Ok((mesh, value))
+}
+
+/// The library's message about the seed or the resolution in the words of
+/// the command line (`--seed …`, `--seed-radius …`, `--resolution …`).
+fn cli_wording(message: &str) -> Option<String> {
+    let message = message.strip_prefix("input: ")?;
+    ["seed radius ", "seed ", "resolution "]
+        .iter()
+        .find_map(|name| {
+            message
+                .strip_prefix(name)
+                .map(|rest| format!("--{} {rest}", name.trim().replace(' ', "-")))
+        })
 }
 
 /// Three z slices through the object (at a quarter, half and three

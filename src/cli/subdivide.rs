@@ -7,9 +7,8 @@ use clap::Args;
 use serde_json::json;
 
 use subdyn::io::write_mesh;
-use subdyn::math::Point3;
 use subdyn::mesh::PolyMesh;
-use subdyn::subdivision::Hierarchy;
+use subdyn::subdivision::{check_uniform_size, uniform_positions};
 
 use super::common::{
     about_file, bbox_json, check_mesh_output, check_output_dir, print_stdout, seconds, thousands,
@@ -19,10 +18,7 @@ use super::options::{RefineArgs, read_polygon_mesh};
 use super::progress::Progress;
 use super::subdivide_scheme::{Scheme, refine_other};
 
-/// Most levels `subdivide` accepts (faces grow by 4× per level).
-pub const MAX_LEVELS: usize = 8;
-/// Most faces `subdivide` will produce.
-pub const MAX_FACES: usize = 50_000_000;
+pub use subdyn::subdivision::{MAX_FACES, MAX_LEVELS};
 
 /// Arguments of `subdyn subdivide`.
 #[derive(Debug, Args)]
@@ -83,7 +79,8 @@ pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
         None => "embedded:cube".to_string(),
     };
     let mesh = mesh?;
-    check_size(&mesh, args.levels, args.limit, &input_name)?;
+    check_uniform_size(&mesh, args.levels, args.limit)
+        .map_err(|e| about_file(e, Path::new(&input_name)))?;
     if args.scheme != Scheme::CatmullClark {
         return run_other(args, &mesh, &input_name);
     }
@@ -97,7 +94,7 @@ pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
 
     progress.stage("computing the positions");
     let (positions, positions_s) =
-        timed(|| positions(&hierarchy, &mesh.positions, args.levels, args.limit));
+        timed(|| uniform_positions(&hierarchy, &mesh.positions, args.levels, args.limit));
     let positions = positions?;
     let bbox = bbox_json(&positions);
     let out = hierarchy.mesh(args.levels, positions);
@@ -202,66 +199,4 @@ fn load(input: Option<&Path>, quiet: bool) -> (anyhow::Result<PolyMesh>, String)
             "the embedded unit cube (8 vertices, 6 quads)".to_string(),
         ),
     }
-}
-
-/// Refuses, before allocating anything, a refinement that would exceed
-/// [`MAX_FACES`] or the memory budget ([`check_refinement_memory`]).
-fn check_size(mesh: &PolyMesh, levels: usize, limit: bool, name: &str) -> anyhow::Result<()> {
-    let faces = estimated_faces(mesh, levels);
-    if faces > MAX_FACES as f64 {
-        anyhow::bail!(
-            "{name}: {levels} levels would make about {} faces (at most {} allowed); use fewer levels",
-            thousands(faces as usize),
-            thousands(MAX_FACES)
-        );
-    }
-    check_refinement_memory(faces, limit, &format!("{levels} levels of {name}"))
-}
-
-/// Bytes a refinement holds per face of its finest level (all levels'
-/// topology, the stencils and the positions; measured on a 12,100-quad
-/// torus: about 360 B at levels 3 and 4, and 920 B with `--limit`, whose
-/// limit stencils are wider).
-const BYTES_PER_FACE: f64 = 400.0;
-/// [`BYTES_PER_FACE`] with the limit stencils of `--limit`.
-const BYTES_PER_LIMIT_FACE: f64 = 1100.0;
-
-/// Refuses a refinement to `faces` faces whose estimated memory is over the
-/// budget (`--max-memory`).
-pub fn check_refinement_memory(faces: f64, limit: bool, what: &str) -> anyhow::Result<()> {
-    let each = if limit {
-        BYTES_PER_LIMIT_FACE
-    } else {
-        BYTES_PER_FACE
-    };
-    subdyn::memory::check_memory(
-        &format!("{what} ({} faces)", thousands(faces as usize)),
-        (faces * each).min(u64::MAX as f64) as u64,
-    )?;
-    Ok(())
-}
-
-/// Faces after `levels` uniform Catmull-Clark levels: an `n`-gon becomes `n`
-/// quads, then every quad becomes 4.
-pub fn estimated_faces(mesh: &PolyMesh, levels: usize) -> f64 {
-    if levels == 0 {
-        return mesh.num_faces() as f64;
-    }
-    mesh.face_vertices.len() as f64 * 4f64.powi(levels as i32 - 1)
-}
-
-/// Positions of level `levels`: refined level by level, or at the limit.
-fn positions(
-    h: &Hierarchy,
-    p0: &[Point3],
-    levels: usize,
-    limit: bool,
-) -> anyhow::Result<Vec<Point3>> {
-    if limit {
-        let table = subdyn::limit::limit_stencil(h, levels)?;
-        return Ok(table.apply(p0)?);
-    }
-    let mut all = h.refine_positions(p0)?;
-    all.pop()
-        .ok_or_else(|| anyhow::anyhow!("the refinement produced no level"))
 }

@@ -198,3 +198,23 @@ fn sample_key(t: &Tile, a: usize, b: usize, k: usize) -> Option<Key> {
     let (lo, hi, j) = if p < q { (p, q, j) } else { (q, p, k - j) };
     Some(Key::OnEdge((lo, hi), j as u32))
 }
+
+/// The limit surface of the control mesh `control` (refined with `options`)
+/// as `--limit-out` writes it: [`tessellate`]d `k × k` per quad, then split
+/// into triangles ([`split_quads`](crate::mesh::split_quads)) unless
+/// `quads`; with one unit normal per vertex.
+pub fn limit_surface_mesh(
+    control: &PolyMesh,
+    options: &crate::subdivision::RefineOptions,
+    k: usize,
+    quads: bool,
+) -> Result<(PolyMesh, Vec<Vector3>)> {
+    let refiner = Refiner::new(control, options)?;
+    let (surf, normals) = tessellate(&refiner, &control.positions, k)?;
+    let surf = if quads {
+        surf
+    } else {
+        crate::mesh::split_quads(&surf)
+    };
+    Ok((surf, normals))
+}

@@ -9,6 +9,7 @@ mod local_refine;
 mod non_uniform;
 mod refine_topology;
 mod refiner;
+mod uniform;
 
 pub use catmull_clark::refine_stencil;
 pub use curves::{CurveScheme, CurveTopology, bernstein, bspline_to_bezier, span_basis};
@@ -20,3 +21,7 @@ pub use local_refine::{CornerImage, LocalRefinement, close_marks, refine_marked}
 pub use non_uniform::{NonUniformHierarchy, check_intervals, non_uniform_step};
 pub use refine_topology::refine_topology;
 pub use refiner::{BoundaryRule, Hierarchy, RefineOptions, Refiner};
+pub use uniform::{
+    MAX_FACES, MAX_LEVELS, check_refinement_memory, check_uniform_size, estimated_faces,
+    uniform_positions,
+};

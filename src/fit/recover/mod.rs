@@ -9,6 +9,7 @@ mod params;
 mod prepare;
 mod quality;
 mod report;
+mod start;
 
 pub use driver::{RecoverResult, recover_shape};
 pub use init::{ComponentCage, component_cage, seed_cage};
@@ -17,3 +18,4 @@ pub use params::{BONE_HU, RecoverParams, SKIN_HU};
 pub use prepare::{PreparedVolume, prepare_volume, prepare_volume_owned};
 pub use quality::poor_result;
 pub use report::{RecoverLevel, RecoverReport};
+pub use start::{RecoverStart, initial_model};

@@ -7,7 +7,7 @@ use std::time::Instant;
 use super::{RecoverParams, padded_at_level};
 use crate::error::{Error, Result};
 use crate::forces::BoundaryModel;
-use crate::math::Real;
+use crate::math::{Point3, Real};
 use crate::volume::{
     Volume, edge_potential, gaussian_smoothed, gaussian_smoothed_owned, otsu_threshold,
 };
@@ -36,6 +36,16 @@ pub struct PreparedVolume {
 impl PreparedVolume {
     /// Samples added before and after each axis of the input's grid.
     pub const PADDING: usize = 1;
+
+    /// The input's grid: its samples per axis and its first sample's world
+    /// point (the spacing is [`smoothed`](Self::smoothed)'s).
+    pub fn input_grid(&self) -> ([usize; 3], Point3) {
+        let pad = Self::PADDING;
+        (
+            self.smoothed.dims().map(|d| d - 2 * pad),
+            self.smoothed.world([pad as Real; 3]),
+        )
+    }
 }
 
 /// The precompute step: smoothing, edge potential and inside level.

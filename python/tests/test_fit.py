@@ -1,0 +1,92 @@
+"""subdyn.fit against the CLI, pickling, threads, watertightness."""
+
+import json
+import pickle
+
+import numpy as np
+import pytest
+
+import subdyn
+from conftest import run
+
+TIMING_KEYS = ("seconds", "elapsed", "_s")
+
+
+def without_timings(value):
+    """The report with every timing field left out (they differ run to run)."""
+    if isinstance(value, dict):
+        return {k: without_timings(v) for k, v in value.items()
+                if not any(t in k for t in TIMING_KEYS)}
+    if isinstance(value, list):
+        return [without_timings(v) for v in value]
+    return value
+
+
+def test_fit_equals_cli(tmp_path, sphere_scan, sphere_fit):
+    run("subdyn", "fit", sphere_scan, "-o", tmp_path / "cli.obj", "--report",
+        tmp_path / "cli.json", "--quiet")
+    vertices, faces = subdyn.read_mesh(tmp_path / "cli.obj")
+    r = sphere_fit
+    points, _ = subdyn.read_points(sphere_scan)
+    diagonal = np.linalg.norm(points.max(0) - points.min(0))
+    assert r.control_vertices.shape == vertices.shape
+    assert np.abs(r.control_vertices - vertices).max() <= 1e-9 * diagonal
+    assert len(r.control_faces) == len(faces)
+    assert all(np.array_equal(a, b) for a, b in zip(r.control_faces, faces))
+    cli = json.load(open(tmp_path / "cli.json"))
+    assert sorted(cli) == sorted(r.report)
+    assert r.report["input"] == f"an array of {len(points)} points"
+    cli = {k: v for k, v in cli.items() if k not in ("input", "output", "limit_out")}
+    ours = {k: v for k, v in r.report.items() if k not in ("input", "output", "limit_out")}
+    assert without_timings(ours) == without_timings(cli)
+    assert r.report["fit"]["levels"], "the report lists the levels"
+
+
+def test_options_reach_the_fit(sphere_scan):
+    points, _ = subdyn.read_points(sphere_scan)
+    coarse = subdyn.fit(points, max_level=0, init="closed", tess=2)
+    assert len(coarse.report["fit"]["levels"]) == 1
+    assert coarse.report["init"]["method"] == "closed"
+    # tess=2 gives 2×2 quads per control quad, 8 triangles each
+    quads = sum(1 if len(f) == 4 else len(f) for f in coarse.control_faces)
+    assert coarse.limit_triangles.shape == (8 * quads, 3)
+    q = subdyn.fit(points, max_level=0, init="closed", tess=2, quads=True)
+    assert q.limit_triangles is None and q.limit_quads.shape == (4 * quads, 4)
+
+
+def test_fit_from_a_given_mesh(sphere_scan, sphere_fit):
+    points, _ = subdyn.read_points(sphere_scan)
+    r = subdyn.fit(points, init=(sphere_fit.init_vertices, sphere_fit.init_faces), max_level=0)
+    assert r.report["init"]["method"] == "mesh"
+    assert r.control_vertices.shape == sphere_fit.init_vertices.shape
+
+
+def test_result_pickles(sphere_fit):
+    r = pickle.loads(pickle.dumps(sphere_fit))
+    assert isinstance(r, subdyn.FitResult)
+    assert np.array_equal(r.control_vertices, sphere_fit.control_vertices)
+    assert np.array_equal(r.limit_triangles, sphere_fit.limit_triangles)
+    assert all(np.array_equal(a, b) for a, b in zip(r.control_faces, sphere_fit.control_faces))
+    assert r.report == sphere_fit.report
+
+
+def test_threads_option_runs_in_its_own_pool(sphere_scan):
+    # The library's patch assembly splits its sums by rayon's thread count,
+    # so one and two threads agree to rounding (about 1e-13), not to the bit;
+    # the CLI with RAYON_NUM_THREADS=1 and 2 differs the same way.
+    points, normals = subdyn.read_points(sphere_scan)
+    one = subdyn.fit(points, normals, threads=1, max_level=1)
+    two = subdyn.fit(points, normals, threads=2, max_level=1)
+    again = subdyn.fit(points, normals, threads=2, max_level=1)
+    diagonal = np.linalg.norm(points.max(0) - points.min(0))
+    assert np.abs(one.control_vertices - two.control_vertices).max() <= 1e-9 * diagonal
+    assert two.control_vertices.tobytes() == again.control_vertices.tobytes()
+
+
+def test_limit_surface_of_a_closed_scan_is_watertight(sphere_fit):
+    o3d = pytest.importorskip("open3d")
+    mesh = subdyn.open3d.to_triangle_mesh(sphere_fit)
+    assert len(mesh.triangles) == len(sphere_fit.limit_triangles)
+    assert mesh.is_watertight()
+    assert mesh.is_orientable()
+    assert isinstance(mesh, o3d.geometry.TriangleMesh)

@@ -1,0 +1,113 @@
+//! [`initial_model`]: where `subdyn recover` starts (a seed sphere, the
+//! cage of a connected component, or a given mesh), shared by the CLI and
+//! the Python package.
+
+use serde_json::{Value, json};
+
+use super::init::{component_cage, seed_cage};
+use super::prepare::PreparedVolume;
+use crate::error::{Error, Result};
+use crate::math::{Point3, Real};
+use crate::mesh::PolyMesh;
+
+/// Where a recovery starts.
+#[derive(Clone, Debug)]
+pub enum RecoverStart {
+    /// A small sphere ([`seed_cage`]) of `radius_voxels` voxels around
+    /// `point`, which must lie inside the object (genus 0 only).
+    Seed {
+        /// World point inside the object.
+        point: Point3,
+        /// Radius in voxels.
+        radius_voxels: Real,
+    },
+    /// The cage of a connected component above the inside level
+    /// ([`component_cage`]): the one holding `seed`, else the largest; any
+    /// genus.
+    Auto {
+        /// World point selecting the component.
+        seed: Option<Point3>,
+        /// Cage cells along the object's longest side (2 to 128).
+        resolution: usize,
+    },
+    /// A given closed control mesh in world coordinates.
+    Mesh(PolyMesh),
+}
+
+/// The initial control mesh for `start` in `prepared`, and the `init` object
+/// of `subdyn recover --report` (`method`: `seed`, `auto` or `mesh`, with
+/// the counts). `bright_inside` is false for dark objects.
+pub fn initial_model(
+    prepared: &PreparedVolume,
+    start: &RecoverStart,
+    bright_inside: bool,
+) -> Result<(PolyMesh, Value)> {
+    let volume = &prepared.smoothed;
+    match start {
+        RecoverStart::Seed {
+            point: p,
+            radius_voxels,
+        } => {
+            if !volume.contains(p) {
+                let (lo, hi) = volume.world_bounds();
+                return Err(Error::Input(format!(
+                    "seed ({}, {}, {}) lies outside the volume, which spans ({:.2}, {:.2}, {:.2}) to ({:.2}, {:.2}, {:.2})",
+                    p.x, p.y, p.z, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+                )));
+            }
+            let v = volume.sample(p);
+            let inside = if bright_inside {
+                v > prepared.inside_level
+            } else {
+                v < prepared.inside_level
+            };
+            if !inside {
+                return Err(Error::Input(format!(
+                    "seed ({}, {}, {}) is not inside the object: the smoothed intensity there is {v:.4}, {} the inside level {:.4}",
+                    p.x,
+                    p.y,
+                    p.z,
+                    if bright_inside {
+                        "not above"
+                    } else {
+                        "not below"
+                    },
+                    prepared.inside_level
+                )));
+            }
+            if !(radius_voxels.is_finite() && *radius_voxels > 0.0) {
+                return Err(Error::Input(format!(
+                    "seed radius {radius_voxels} must be positive"
+                )));
+            }
+            let mesh = seed_cage(*p, radius_voxels * volume.voxel_size())?;
+            let value = json!({"method": "seed", "seed": [p.x, p.y, p.z],
+                "radius_voxels": radius_voxels,
+                "vertices": mesh.num_vertices(), "faces": mesh.num_faces()});
+            Ok((mesh, value))
+        }
+        RecoverStart::Mesh(mesh) => {
+            let value = json!({"method": "mesh",
+                "vertices": mesh.num_vertices(), "faces": mesh.num_faces()});
+            Ok((mesh.clone(), value))
+        }
+        RecoverStart::Auto { seed, resolution } => {
+            if !(2..=128).contains(resolution) {
+                return Err(Error::Input(format!(
+                    "resolution {resolution} is out of range: expected 2 to 128"
+                )));
+            }
+            let cage = component_cage(
+                volume,
+                prepared.inside_level,
+                bright_inside,
+                *seed,
+                *resolution,
+            )?;
+            let value = json!({"method": "auto", "component_voxels": cage.voxels,
+                "components": cage.components, "block_voxels": cage.block, "genus": cage.genus,
+                "vertices": cage.mesh.num_vertices(), "faces": cage.mesh.num_faces()});
+            Ok((cage.mesh, value))
+        }
+    }
+}
