@@ -72,6 +72,53 @@ fn a_torus_is_recovered_from_its_thresholded_component_with_edges() {
     assert!(subdyn::fit::recover::poor_result(&out.report, &params).is_empty());
 }
 
+/// A ball with a rod 2 voxels thick and 14 long (a leg, a vessel): the
+/// automatic cage keeps the rod, which blocks of the cage's size (3 voxels
+/// at resolution 12) would lose, and the recovered surface reaches its tip.
+#[test]
+fn a_rod_two_voxels_thick_is_kept_by_the_automatic_cage() {
+    let c = Point3::new(16.0, 20.0, 20.0);
+    let (from, tip) = (Point3::new(22.0, 20.0, 20.0), Point3::new(36.0, 20.0, 20.0));
+    let sdf = move |p: Point3| {
+        let ball = (p - c).norm() - 9.0;
+        let t = ((p - from).dot(&(tip - from)) / (tip - from).norm_squared()).clamp(0.0, 1.0);
+        let rod = (p - (from + t * (tip - from))).norm() - 1.0;
+        ball.min(rod)
+    };
+    // Cubic voxels, and voxels half as deep along y (the rod is then two
+    // voxels across in z, four in y).
+    for (dims, spacing) in [([42, 40, 40], [1.0; 3]), ([42, 80, 40], [1.0, 0.5, 1.0])] {
+        let vol = sdf_volume(dims, spacing, sdf);
+        let params = RecoverParams {
+            boundary: BoundaryModel::Iso { value: 0.5 },
+            ..Default::default()
+        };
+        let prepared = prepare_volume(&vol, &params).unwrap();
+        let cage = component_cage(&prepared.smoothed, 0.5, true, None, 12).unwrap();
+        assert!(cage.block >= 3, "block {}", cage.block);
+        let out = recover_shape(&prepared, &cage.mesh, &[], &params, &mut |_, _, _| {}).unwrap();
+        let refiner = Refiner::new(&out.control, &RefineOptions::default()).unwrap();
+        let (tess, _) = tessellate(&refiner, &out.control.positions, 4).unwrap();
+        let reach = tess
+            .positions
+            .iter()
+            .map(|p| p.x)
+            .fold(Real::MIN, Real::max);
+        let (max, mean) = surface_error(&out.control, sdf);
+        println!(
+            "spacing {spacing:?}: cage {} vertices (blocks of {}, {} voxels lost, simplified from {:?}); reach x = {reach:.2} (tip 37); max {max:.3} mean {mean:.3} voxels; {}",
+            cage.mesh.num_vertices(),
+            cage.block,
+            cage.lost_voxels,
+            cage.simplified_from,
+            out.report.stop_reason
+        );
+        assert!(reach > 35.5, "the rod ends at x = {reach}, not 37");
+        assert!(mean < 0.3 && max < 1.0, "mean {mean} max {max}");
+        assert!(subdyn::fit::recover::poor_result(&out.report, &params).is_empty());
+    }
+}
+
 #[test]
 fn the_recover_verb_writes_the_shape_report_and_slices_and_rejects_bad_input() {
     let dir = tempfile::tempdir().unwrap();

@@ -50,6 +50,82 @@ fn a_ball_cut_by_the_box_closes_on_the_box_face() {
     assert!(cap.len() > 100 && worst <= 0.5, "{} {worst}", cap.len());
 }
 
+/// With `--open-at-box` the same ball is left open where the box cuts it:
+/// one boundary loop, its rim on the box face (within half a voxel).
+#[test]
+fn open_at_box_leaves_the_cut_open_with_its_rim_on_the_face() {
+    let c = Point3::new(16.0, 16.0, 26.0);
+    let vol = sdf_volume([32, 32, 32], [1.0; 3], move |p| (p - c).norm() - 10.0);
+    let dir = tempfile::tempdir().unwrap();
+    let path = write_raw(dir.path(), "ball", &vol);
+    let run = |extra: &[&str]| {
+        let mut args = vec!["recover", path.to_str().unwrap(), "--iso", "0.5", "--quiet"];
+        args.extend_from_slice(extra);
+        common::run_subdyn(dir.path(), &args)
+    };
+    let out = run(&["-o", "open.obj", "--limit-out", "open.ply", "--open-at-box"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let control = subdyn::io::read_mesh(dir.path().join("open.obj")).unwrap();
+    let topo = subdyn::fit::init::surface_topology(&control).unwrap();
+    assert_eq!((topo.boundary_loops, topo.components), (1, 1));
+    let limit = subdyn::io::read_mesh(dir.path().join("open.ply")).unwrap();
+    let rim = boundary_vertices(&limit);
+    let worst = rim
+        .iter()
+        .map(|&v| (limit.positions[v].z - 31.5).abs())
+        .fold(0.0, Real::max);
+    println!(
+        "{} rim vertices, farthest {worst:.3} voxels from the face",
+        rim.len()
+    );
+    assert!(rim.len() > 20 && worst <= 0.5, "{} {worst}", rim.len());
+    // A ball inside the box has nothing to open.
+    let inside = sdf_volume([32, 32, 32], [1.0; 3], |p| {
+        (p - Point3::new(16.0, 16.0, 16.0)).norm() - 9.0
+    });
+    let path = write_raw(dir.path(), "inside", &inside);
+    let out = common::run_subdyn(
+        dir.path(),
+        &[
+            "recover",
+            path.to_str().unwrap(),
+            "--iso",
+            "0.5",
+            "--open-at-box",
+            "-o",
+            "x.obj",
+            "--quiet",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("does not reach the volume's box"), "{err}");
+    assert!(!dir.path().join("x.obj").exists());
+}
+
+/// Vertices on an edge of only one face.
+fn boundary_vertices(mesh: &subdyn::mesh::PolyMesh) -> Vec<usize> {
+    let mut edges = std::collections::HashMap::new();
+    for f in mesh.faces() {
+        for i in 0..f.len() {
+            let (a, b) = (f[i], f[(i + 1) % f.len()]);
+            *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    let mut rim: Vec<usize> = edges
+        .iter()
+        .filter(|(_, n)| **n == 1)
+        .flat_map(|((a, b), _)| [*a as usize, *b as usize])
+        .collect();
+    rim.sort_unstable();
+    rim.dedup();
+    rim
+}
+
 /// A NIfTI-1 int16 volume with `scl_slope`, `scl_inter` (stored =
 /// (value − inter) / slope, rounded), unit voxels at the origin.
 fn write_int16_nifti(path: &std::path::Path, vol: &Volume, slope: f32, inter: f32) {

@@ -9,7 +9,7 @@ use pyo3::types::PyDict;
 use serde_json::json;
 
 use subdyn::fit::recover::{
-    BONE_HU, RecoverParams, RecoverStart, SKIN_HU, initial_model, poor_result,
+    BONE_HU, RecoverParams, RecoverStart, SKIN_HU, initial_model, opened_at_box, poor_result,
     prepare_volume_owned, recover_shape,
 };
 use subdyn::forces::BoundaryModel;
@@ -40,6 +40,7 @@ const RECOVER_OPTIONS: &[&str] = &[
     "quads",
     "threads",
     "accept_poor",
+    "open_at_box",
 ];
 
 /// Recovers a closed shape from `data` (x fastest, `dims` samples) on the
@@ -90,6 +91,7 @@ pub fn recover<'py>(
     }
     let quads = o.flag("quads")?;
     let accept_poor = o.flag("accept_poor")?;
+    let open_at_box = o.flag("open_at_box")?;
     let threads = o.opt_usize("threads")?;
     let seed = o.triple("seed")?.map(|s| Point3::new(s[0], s[1], s[2]));
     let start = match (&init_mesh, seed) {
@@ -108,7 +110,7 @@ pub fn recover<'py>(
         None => Vec::new(),
     };
     let data = data.as_array().to_vec();
-    let (init, result, limit, report) = without_gil(py, threads, || {
+    let (init, control, limit, report) = without_gil(py, threads, || {
         let volume = Volume::new(dims, data, spacing, Point3::from(origin))?;
         let prepared = prepare_volume_owned(volume, &params)?;
         let t = Instant::now();
@@ -122,7 +124,12 @@ pub fn recover<'py>(
                 problems.join("; ")
             )));
         }
-        let limit = limit_surface_mesh(&result.control, &Default::default(), tess, quads)?;
+        let control = if open_at_box {
+            opened_at_box(&result.control, &prepared.smoothed)?
+        } else {
+            result.control
+        };
+        let limit = limit_surface_mesh(&control, &Default::default(), tess, quads)?;
         let (grid_dims, grid_origin) = prepared.input_grid();
         let report = json!({
             "command": "recover",
@@ -145,16 +152,19 @@ pub fn recover<'py>(
             "poor_result": problems,
             "total_s": started.elapsed().as_secs_f64(),
         });
-        Ok((init, result, limit, report))
+        Ok((init, control, limit, report))
     })?;
-    result_dict(py, &init, &result.control, &limit, &report)
+    result_dict(py, &init, &control, &limit, &report)
 }
 
 /// The iso-value of `iso=` or of `preset=` ("skin" or "bone", Hounsfield
 /// units), not both; `None` for edges.
 fn iso_value(o: &Options) -> PyResult<Option<f64>> {
     let iso = o.opt_f64("iso")?;
-    let preset = match o.choice("preset", "none", &["none", "skin", "bone"])?.as_str() {
+    let preset = match o
+        .choice("preset", "none", &["none", "skin", "bone"])?
+        .as_str()
+    {
         "skin" => Some(SKIN_HU),
         "bone" => Some(BONE_HU),
         _ => None,

@@ -68,3 +68,33 @@ def test_ct_presets_and_poor_results(sphere_volume):
         subdyn.recover(*args, init=(cube, faces), iso=0.5, max_level=0)
     r = subdyn.recover(*args, init=(cube, faces), iso=0.5, max_level=0, accept_poor=True)
     assert any("leaves the volume's box" in p for p in r.report["poor_result"])
+
+
+def boundary_vertices(faces):
+    """The vertices on edges used by one face."""
+    count = {}
+    for f in faces:
+        for a, b in zip(f, np.roll(f, -1)):
+            e = (min(a, b), max(a, b))
+            count[e] = count.get(e, 0) + 1
+    return sorted({v for e, c in count.items() if c == 1 for v in e})
+
+
+def test_open_at_box(sphere_volume):
+    _, volume, meta = sphere_volume
+    # The sphere cut a quarter of the way down from its top by the box.
+    nz = volume.shape[2]
+    z_index = [i for i in range(nz) if volume[:, :, i].max() > 0.5]
+    k = z_index[-1] - (z_index[-1] - z_index[0]) // 4
+    cut = volume[:, :, : k + 1]
+    face = meta["origin"][2] + (k + 0.5) * meta["spacing"][2]
+    args = (cut, meta["spacing"], meta["origin"])
+    closed = subdyn.recover(*args, iso=0.5)
+    assert boundary_vertices(closed.control_faces) == []
+    opened = subdyn.recover(*args, iso=0.5, open_at_box=True)
+    rim = boundary_vertices(opened.limit_faces)
+    assert len(rim) > 20
+    off = np.abs(opened.limit_vertices[rim, 2] - face) / meta["spacing"][2]
+    assert off.max() <= 0.5, off.max()
+    with pytest.raises(ValueError, match="does not reach the volume's box"):
+        subdyn.recover(volume, meta["spacing"], meta["origin"], iso=0.5, open_at_box=True)

@@ -9,8 +9,8 @@ use clap::Args;
 use serde_json::json;
 
 use subdyn::fit::recover::{
-    BONE_HU, PreparedVolume, RecoverParams, RecoverReport, RecoverStart, SKIN_HU, poor_result,
-    prepare_volume_owned, recover_shape,
+    BONE_HU, PreparedVolume, RecoverParams, RecoverReport, RecoverStart, SKIN_HU, opened_at_box,
+    poor_result, prepare_volume_owned, recover_shape,
 };
 use subdyn::forces::BoundaryModel;
 use subdyn::io::{VolumeFile, VolumeReadOptions, read_points, read_volume, write_mesh};
@@ -119,6 +119,12 @@ pub struct RecoverArgs {
     /// a result is an error and nothing is written.
     #[arg(long)]
     pub accept_poor: bool,
+    /// Leave an object cut by the volume's box open there: the faces lying
+    /// on a box face are removed, the rim stays on it (by default the
+    /// surface closes on the box faces, as marching cubes on a padded
+    /// volume does).
+    #[arg(long)]
+    pub open_at_box: bool,
     /// No progress display.
     #[arg(short, long)]
     pub quiet: bool,
@@ -257,13 +263,20 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
             ("evolution", evolution_peak),
         ],
     };
+    let opened;
+    let control = if args.open_at_box {
+        opened = opened_at_box(&result.control, &prepared.smoothed)?;
+        &opened
+    } else {
+        &result.control
+    };
     progress.stage(format!("writing {}", args.output.display()));
-    write_mesh(&args.output, &result.control, None).map_err(|e| about_file(e, &args.output))?;
+    write_mesh(&args.output, control, None).map_err(|e| about_file(e, &args.output))?;
     let surface = |mesh: &PolyMesh| -> anyhow::Result<(PolyMesh, Vec<subdyn::math::Vector3>)> {
         let refiner = Refiner::new(mesh, &RefineOptions::default())?;
         Ok(tessellate(&refiner, &mesh.positions, args.tess)?)
     };
-    let (surf, normals) = surface(&result.control)?;
+    let (surf, normals) = surface(control)?;
     if let Some(path) = &args.limit_out {
         write_mesh(path, &args.faces.mesh(&surf), Some(&normals))
             .map_err(|e| about_file(e, path))?;
@@ -461,7 +474,7 @@ fn summary(
         ));
     }
     s.push_str(
-        "(offsets: surface to the boundary found along its normal; unresolved: share of the surface that found no boundary within the search range along its normal (± a third of the mean control edge, 2 to 12 voxels), so the thin plate, not the image, placed it)\n",
+        "(offsets: surface to the boundary found along its normal; unresolved: share of the surface that found no boundary within the search range along its normal (± a third of the median control edge, 2 to 12 voxels), so the thin plate, not the image, placed it)\n",
     );
     if written {
         s.push_str(&format!("wrote {}", args.output.display()));

@@ -110,7 +110,7 @@ pub fn recover_shape(
         let search_of = |p: &[Point3]| {
             params
                 .search_voxels
-                .unwrap_or((mean_edge_length(&mesh, p) / voxel / 3.0).clamp(2.0, 12.0))
+                .unwrap_or((median_edge_length(&mesh, p) / voxel / 3.0).clamp(2.0, 12.0))
         };
         let max_steps = if level == 0 {
             4 * params.max_steps
@@ -130,7 +130,7 @@ pub fn recover_shape(
         // User points pull a patch as wide as a level-0 control edge at
         // every level (each subdivision halves the edges).
         let point_radius =
-            (1u64 << level.min(30)) as Real * mean_edge_length(&mesh, &mesh.positions);
+            (1u64 << level.min(30)) as Real * median_edge_length(&mesh, &mesh.positions);
         let mut p = mesh.positions.clone();
         let mut energy: Vec<Real> = Vec::new();
         let (mut steps, mut cg_iterations, mut still) = (0, 0, false);
@@ -340,7 +340,7 @@ pub fn recover_shape(
                 ),
             );
         }
-        let edge = mean_edge_length(&mesh, &mesh.positions);
+        let edge = median_edge_length(&mesh, &mesh.positions);
         if 0.5 * edge < params.min_edge_voxels * voxel {
             break (
                 false,
@@ -388,15 +388,15 @@ fn voxels_outside_box(volume: &crate::volume::Volume, x: &Point3) -> Real {
 
 /// Mean length of the control mesh's edges at positions `p` (each face side
 /// counted once per face).
-fn mean_edge_length(mesh: &PolyMesh, p: &[Point3]) -> Real {
-    let (mut sum, mut n) = (0.0, 0usize);
-    for f in 0..mesh.num_faces() {
-        let face = mesh.face(f);
-        for (i, &a) in face.iter().enumerate() {
-            let b = face[(i + 1) % face.len()];
-            sum += (p[a as usize] - p[b as usize]).norm();
-            n += 1;
-        }
+fn median_edge_length(mesh: &PolyMesh, p: &[Point3]) -> Real {
+    let mut lengths: Vec<Real> = mesh
+        .faces()
+        .flat_map(|face| (0..face.len()).map(move |i| (face[i], face[(i + 1) % face.len()])))
+        .map(|(a, b)| (p[a as usize] - p[b as usize]).norm())
+        .collect();
+    if lengths.is_empty() {
+        return 0.0;
     }
-    sum / n.max(1) as Real
+    let mid = lengths.len() / 2;
+    *lengths.select_nth_unstable_by(mid, Real::total_cmp).1
 }

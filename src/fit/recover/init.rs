@@ -10,7 +10,7 @@ use crate::fit::init::voxel_surface::{boundary_quads, taubin_smoothed};
 use crate::fit::init::voxels::{FACE_NEIGHBOURS, VoxelGrid};
 use crate::fit::init::{signed_volume, surface_topology};
 use crate::math::{Point3, Real};
-use crate::mesh::PolyMesh;
+use crate::mesh::{PolyMesh, simplified};
 use crate::subdivision::{RefineOptions, Refiner};
 use crate::volume::Volume;
 
@@ -45,8 +45,15 @@ pub struct ComponentCage {
     pub voxels: usize,
     /// Components of the thresholded volume.
     pub components: usize,
-    /// Voxels per cage cell along each axis.
+    /// Voxels per block of the coarse cage along each axis.
     pub block: usize,
+    /// Voxels of the component more than a block from the coarse cage's
+    /// blocks (parts they lost).
+    pub lost_voxels: usize,
+    /// The block size (1: the voxels) whose boundary was simplified into
+    /// the cage, when the coarse blocks lost a part; `None`: the coarse
+    /// blocks' boundary is the cage.
+    pub simplified_from: Option<usize>,
     /// Genus of the cage.
     pub genus: i64,
 }
@@ -57,7 +64,14 @@ pub struct ComponentCage {
 /// (`b` chosen so the longest side spans about `resolution` blocks; a block
 /// is solid when at least half its voxels are), cavities are filled, the
 /// block set is made a 2-manifold, and its boundary quads, Taubin-smoothed,
-/// form the cage. Holes narrower than about two blocks close up.
+/// form the cage. When the blocks lose a part (more than 0.2 % of the
+/// component's voxels lie more than a block from every solid block: a leg,
+/// a rod, a sheet thinner than the blocks), the same boundary of the voxels
+/// themselves is simplified ([`simplified`]) towards as many vertices
+/// instead (at most a tenth of its own, else blocks 2, 4, … voxels wide are
+/// tried): a triangle cage, fine where the object is thin, that keeps every part and
+/// hole down to a voxel or two thick. Holes narrower than about two blocks
+/// in an object that lost no part close up.
 pub fn component_cage(
     volume: &Volume,
     level: Real,
@@ -153,14 +167,123 @@ pub fn component_cage(
     let (lo, hi) = boxes[chosen];
     let extent = (0..3).map(|a| hi[a] - lo[a] + 1).max().unwrap_or(1);
     let block = extent.div_ceil(resolution.max(2)).max(1);
-    const MARGIN: usize = 2;
+    let grid_of = |block: usize| -> Result<(VoxelGrid, PolyMesh)> {
+        let mut grid = block_grid(volume, &label, chosen as u32, (lo, hi), block);
+        grid.fill_cavities();
+        grid.keep_largest_component();
+        make_manifold(&mut grid);
+        grid.keep_largest_component();
+        if grid.count() == 0 {
+            return Err(Error::Input(format!(
+                "the object ({} voxels) vanishes at {block}-voxel blocks; raise the resolution",
+                sizes[chosen]
+            )));
+        }
+        // Block corner c is at voxel index lo + (c − margin) b − ½ (voxel faces).
+        let corner = |c: [usize; 3]| {
+            volume.world(
+                [0, 1, 2]
+                    .map(|a| lo[a] as Real + (c[a] as Real - MARGIN as Real) * block as Real - 0.5),
+            )
+        };
+        let mesh = taubin_smoothed(&boundary_quads(&grid, corner)?, 10);
+        Ok((grid, mesh))
+    };
+    let (coarse, coarse_mesh) = grid_of(block)?;
+    // Voxels of the component more than a block from every solid block: a
+    // part the blocks lost (a leg, a rod, a thin sheet).
+    let mut lost = 0usize;
+    for z in lo[2]..=hi[2] {
+        for y in lo[1]..=hi[1] {
+            for x in lo[0]..=hi[0] {
+                if label[volume.index(x, y, z)] != chosen as u32 {
+                    continue;
+                }
+                let g = [x - lo[0], y - lo[1], z - lo[2]].map(|c| (c / block + MARGIN) as isize);
+                let near = NEIGHBOURHOOD
+                    .iter()
+                    .any(|d| coarse.get([g[0] + d[0], g[1] + d[1], g[2] + d[2]]));
+                lost += usize::from(!near);
+            }
+        }
+    }
+    // When the blocks lost a part, the voxels' own boundary is simplified
+    // towards the coarse cage's number of vertices, with edges up to two
+    // blocks long (along the coarsest axis, so anisotropic voxels do not
+    // hold it back) so the cells stay about as even as the blocks'. Its
+    // topology may keep it above that; it is taken when it reaches that
+    // number or has at most a tenth of the boundary's vertices, else the
+    // boundary of blocks 2, 4, … voxels wide is tried (fine structure such
+    // as a folded sheet's tunnels fades at coarser blocks).
+    let target = coarse_mesh.num_vertices();
+    let max_edge = 2.0 * block as Real * volume.spacing().into_iter().fold(0.0, Real::max);
+    let mut simplified_from = None;
+    let mut mesh = coarse_mesh;
+    if lost as Real > LOST_PART * sizes[chosen] as Real {
+        let mut fine = 1;
+        while fine < block {
+            let boundary = grid_of(fine)?.1;
+            let cage = simplified(&boundary, target, max_edge)?;
+            if cage.num_vertices() <= target.max(boundary.num_vertices() / 10) {
+                mesh = cage;
+                simplified_from = Some(fine);
+                break;
+            }
+            fine *= 2;
+        }
+    }
+    let mesh = oriented_outward(mesh)?;
+    let topo = surface_topology(&mesh)?;
+    Ok(ComponentCage {
+        mesh,
+        voxels: sizes[chosen],
+        components: sizes.len(),
+        block,
+        lost_voxels: lost,
+        simplified_from,
+        genus: topo.genus,
+    })
+}
+
+/// A component whose blocks lose more than this share of its voxels gets
+/// the simplified cage.
+const LOST_PART: Real = 0.002;
+
+/// The block and its 26 neighbours.
+const NEIGHBOURHOOD: [[isize; 3]; 27] = {
+    let mut n = [[0isize; 3]; 27];
+    let mut i = 0;
+    while i < 27 {
+        n[i] = [
+            (i % 3) as isize - 1,
+            ((i / 3) % 3) as isize - 1,
+            (i / 9) as isize - 1,
+        ];
+        i += 1;
+    }
+    n
+};
+
+/// Empty cells around the blocks of [`block_grid`].
+const MARGIN: usize = 2;
+
+/// The blocks of `block³` voxels of the box `lo..=hi` holding component
+/// `chosen` of `label`, with [`MARGIN`] empty blocks around: a block is
+/// solid when at least half its voxels are in the component.
+fn block_grid(
+    volume: &Volume,
+    label: &[u32],
+    chosen: u32,
+    (lo, hi): ([usize; 3], [usize; 3]),
+    block: usize,
+) -> VoxelGrid {
     let gdims = [0, 1, 2].map(|a| (hi[a] - lo[a] + 1).div_ceil(block) + 2 * MARGIN);
     let mut grid = VoxelGrid::new(gdims);
     let mut count = vec![0u32; grid.solid.len()];
     for z in lo[2]..=hi[2] {
         for y in lo[1]..=hi[1] {
             for x in lo[0]..=hi[0] {
-                if label[volume.index(x, y, z)] == chosen as u32 {
+                if label[volume.index(x, y, z)] == chosen {
                     let g =
                         [x - lo[0], y - lo[1], z - lo[2]].map(|c| (c / block + MARGIN) as isize);
                     if let Some(i) = grid.index(g) {
@@ -170,38 +293,11 @@ pub fn component_cage(
             }
         }
     }
-    drop(label);
     let half = (block * block * block).div_ceil(2) as u32;
     for (s, &c) in grid.solid.iter_mut().zip(&count) {
         *s = c >= half.max(1);
     }
-    grid.fill_cavities();
-    grid.keep_largest_component();
-    make_manifold(&mut grid);
-    grid.keep_largest_component();
-    if grid.count() == 0 {
-        return Err(Error::Input(format!(
-            "the object ({} voxels) vanishes at {block}-voxel blocks; raise the resolution",
-            sizes[chosen]
-        )));
-    }
-    // Block corner c is at voxel index lo + (c − margin) b − ½ (voxel faces).
-    let corner = |c: [usize; 3]| {
-        volume.world(
-            [0, 1, 2]
-                .map(|a| lo[a] as Real + (c[a] as Real - MARGIN as Real) * block as Real - 0.5),
-        )
-    };
-    let blocky = boundary_quads(&grid, corner)?;
-    let mesh = oriented_outward(taubin_smoothed(&blocky, 10))?;
-    let topo = surface_topology(&mesh)?;
-    Ok(ComponentCage {
-        mesh,
-        voxels: sizes[chosen],
-        components: sizes.len(),
-        block,
-        genus: topo.genus,
-    })
+    grid
 }
 
 /// The mesh with faces reversed if its signed volume is negative (a

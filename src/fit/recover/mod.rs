@@ -13,7 +13,7 @@ mod start;
 
 pub use driver::{RecoverResult, recover_shape};
 pub use init::{ComponentCage, component_cage, seed_cage};
-pub use pad::padded_at_level;
+pub use pad::{opened_at_box, padded_at_level};
 pub use params::{BONE_HU, RecoverParams, SKIN_HU};
 pub use prepare::{PreparedVolume, prepare_volume, prepare_volume_owned};
 pub use quality::poor_result;

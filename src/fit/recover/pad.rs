@@ -1,8 +1,9 @@
 //! Closing objects cut by the volume's box: one layer of "outside" samples
 //! around the grid, placed so the iso-surface closes on the box faces.
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::math::Real;
+use crate::mesh::PolyMesh;
 use crate::volume::Volume;
 
 /// `volume` with one more sample on every side of every axis (dims `n + 2`,
@@ -59,4 +60,62 @@ fn clamped(i: usize, n: usize) -> (usize, bool) {
     } else {
         (i - 1, false)
     }
+}
+
+/// `control` (the closed result on the padded grid `padded`) opened where
+/// the box cut the object (`--open-at-box`): every face whose vertices all
+/// lie on one face of the input's box (within half a voxel of it, or beyond)
+/// is removed, with the vertices no face keeps. The vertices of the rim
+/// stay on the face, so the limit surface's boundary lies in it. Errors when
+/// no face is removed (the object does not touch the box) or every face is.
+pub fn opened_at_box(control: &PolyMesh, padded: &Volume) -> Result<PolyMesh> {
+    let dims = padded.dims();
+    let index: Vec<[Real; 3]> = control
+        .positions
+        .iter()
+        .map(|p| padded.continuous_index(p))
+        .collect();
+    // Input samples are padded indices 1 ..= n − 2; its box faces at ½ and
+    // n − 1.5; "on the face" is within half a voxel: index ≤ 1 or ≥ n − 2.
+    let on = |v: u32, axis: usize, high: bool| {
+        let c = index[v as usize][axis];
+        if high {
+            c >= dims[axis] as Real - 2.0
+        } else {
+            c <= 1.0
+        }
+    };
+    let mut keep = Vec::new();
+    for f in control.faces() {
+        let capped = (0..3).any(|axis| {
+            [false, true]
+                .iter()
+                .any(|&high| f.iter().all(|&v| on(v, axis, high)))
+        });
+        if !capped {
+            keep.push(f.to_vec());
+        }
+    }
+    if keep.len() == control.num_faces() {
+        return Err(Error::Input(
+            "--open-at-box: the object does not reach the volume's box, nothing to open".into(),
+        ));
+    }
+    if keep.is_empty() {
+        return Err(Error::Input(
+            "--open-at-box: the whole surface lies on the volume's box".into(),
+        ));
+    }
+    let mut new_index = vec![u32::MAX; control.num_vertices()];
+    let mut positions = Vec::new();
+    for f in &mut keep {
+        for v in f.iter_mut() {
+            if new_index[*v as usize] == u32::MAX {
+                new_index[*v as usize] = positions.len() as u32;
+                positions.push(control.positions[*v as usize]);
+            }
+            *v = new_index[*v as usize];
+        }
+    }
+    PolyMesh::from_faces(positions, &keep)
 }

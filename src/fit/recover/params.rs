@@ -59,11 +59,11 @@ pub struct RecoverParams {
     /// Stop subdividing when a level lowers the RMS offset by less than this
     /// fraction (default 0.1).
     pub min_level_gain: Real,
-    /// Do not subdivide when the mean control edge would be shorter than this
+    /// Do not subdivide when the median control edge would be shorter than this
     /// many voxels (default 2).
     pub min_edge_voxels: Real,
     /// Half-length of the search along each normal, in voxels (default
-    /// `None`: a third of the mean control edge, clamped to 2 ..= 12 voxels).
+    /// `None`: a third of the median control edge, clamped to 2 ..= 12 voxels).
     pub search_voxels: Option<Real>,
     /// Tension weight `λ_t` (as in [`FitParams`](crate::fit::FitParams); default 1e-5).
     pub tension: Real,

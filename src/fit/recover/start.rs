@@ -105,7 +105,9 @@ pub fn initial_model(
                 *resolution,
             )?;
             let value = json!({"method": "auto", "component_voxels": cage.voxels,
-                "components": cage.components, "block_voxels": cage.block, "genus": cage.genus,
+                "components": cage.components, "block_voxels": cage.block,
+                "lost_voxels": cage.lost_voxels, "simplified_from_block": cage.simplified_from,
+                "genus": cage.genus,
                 "vertices": cage.mesh.num_vertices(), "faces": cage.mesh.num_faces()});
             Ok((cage.mesh, value))
         }
