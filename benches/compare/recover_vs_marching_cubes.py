@@ -1105,6 +1105,7 @@ def main() -> None:
     ap.add_argument("--no-mni", action="store_true", help="skip the MNI templates")
     ap.add_argument("--upgrade", action="store_true", help="reinstall the venv packages")
     args = ap.parse_args()
+    args.out.mkdir(parents=True, exist_ok=True)
     ensure_venv(args)
     args.subdyn, args.data_gen = args.subdyn.resolve(), args.data_gen.resolve()
     t_start = time.perf_counter()
