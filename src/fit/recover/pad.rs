@@ -2,7 +2,9 @@
 //! around the grid, placed so the iso-surface closes on the box faces.
 
 use crate::error::{Error, Result};
-use crate::math::Real;
+use std::f64::consts::FRAC_1_SQRT_2;
+
+use crate::math::{Real, Vector3};
 use crate::mesh::PolyMesh;
 use crate::volume::Volume;
 
@@ -64,10 +66,12 @@ fn clamped(i: usize, n: usize) -> (usize, bool) {
 
 /// `control` (the closed result on the padded grid `padded`) opened where
 /// the box cut the object (`--open-at-box`): every face whose vertices all
-/// lie on one face of the input's box (within half a voxel of it, or beyond)
-/// is removed, with the vertices no face keeps. The vertices of the rim
-/// stay on the face, so the limit surface's boundary lies in it. Errors when
-/// no face is removed (the object does not touch the box) or every face is.
+/// lie on one face of the input's box (within 1.5 voxels of it, or beyond)
+/// and that faces out through it is removed, with the vertices no face keeps. The vertices of the rim are
+/// moved onto that face (the cage lies up to a voxel or two outside the
+/// surface), so the limit surface's boundary, the B-spline of the rim
+/// (edge-and-corner rule), lies in it. Errors when no face is removed (the
+/// object does not touch the box) or every face is.
 pub fn opened_at_box(control: &PolyMesh, padded: &Volume) -> Result<PolyMesh> {
     let dims = padded.dims();
     let index: Vec<[Real; 3]> = control
@@ -76,24 +80,52 @@ pub fn opened_at_box(control: &PolyMesh, padded: &Volume) -> Result<PolyMesh> {
         .map(|p| padded.continuous_index(p))
         .collect();
     // Input samples are padded indices 1 ..= n − 2; its box faces at ½ and
-    // n − 1.5; "on the face" is within half a voxel: index ≤ 1 or ≥ n − 2.
+    // n − 1.5. The closed result's cap lies on the face, its control points
+    // up to a voxel or two inside or beyond it: a face is a cap when its
+    // vertices are within 1.5 voxels inside the face (index ≤ 2 or
+    // ≥ n − 3) or beyond, and it faces out through the box face (normal
+    // within 45° of the outward axis).
     let on = |v: u32, axis: usize, high: bool| {
         let c = index[v as usize][axis];
         if high {
-            c >= dims[axis] as Real - 2.0
+            c >= dims[axis] as Real - 3.0
         } else {
-            c <= 1.0
+            c <= 2.0
         }
     };
+    let origin = padded.world([0.0; 3]);
+    let outward = |axis: usize, high: bool| {
+        let mut e = [0.0; 3];
+        e[axis] = if high { 1.0 } else { -1.0 };
+        (padded.world(e) - origin).normalize()
+    };
+    let faces_out = |f: &[u32], axis: usize, high: bool| {
+        // Newell's normal of the polygon.
+        let mut n = Vector3::zeros();
+        for (i, &a) in f.iter().enumerate() {
+            let (p, q) = (
+                control.positions[a as usize],
+                control.positions[f[(i + 1) % f.len()] as usize],
+            );
+            n += p.coords.cross(&q.coords);
+        }
+        n.dot(&outward(axis, high)) >= FRAC_1_SQRT_2 * n.norm()
+    };
     let mut keep = Vec::new();
+    // Per vertex and axis, the index of the box face of a removed face.
+    let mut face_of = vec![[None::<Real>; 3]; control.num_vertices()];
     for f in control.faces() {
-        let capped = (0..3).any(|axis| {
-            [false, true]
-                .iter()
-                .any(|&high| f.iter().all(|&v| on(v, axis, high)))
-        });
-        if !capped {
-            keep.push(f.to_vec());
+        let capped = (0..3)
+            .flat_map(|axis| [(axis, false), (axis, true)])
+            .find(|&(axis, high)| f.iter().all(|&v| on(v, axis, high)) && faces_out(f, axis, high));
+        match capped {
+            Some((axis, high)) => {
+                let at = if high { dims[axis] as Real - 1.5 } else { 0.5 };
+                for &v in f {
+                    face_of[v as usize][axis] = Some(at);
+                }
+            }
+            None => keep.push(f.to_vec()),
         }
     }
     if keep.len() == control.num_faces() {
@@ -112,7 +144,15 @@ pub fn opened_at_box(control: &PolyMesh, padded: &Volume) -> Result<PolyMesh> {
         for v in f.iter_mut() {
             if new_index[*v as usize] == u32::MAX {
                 new_index[*v as usize] = positions.len() as u32;
-                positions.push(control.positions[*v as usize]);
+                let mut c = index[*v as usize];
+                for (c, at) in c.iter_mut().zip(face_of[*v as usize]) {
+                    *c = at.unwrap_or(*c);
+                }
+                positions.push(if face_of[*v as usize] == [None; 3] {
+                    control.positions[*v as usize]
+                } else {
+                    padded.world(c)
+                });
             }
             *v = new_index[*v as usize];
         }
