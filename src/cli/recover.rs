@@ -119,8 +119,8 @@ pub struct RecoverArgs {
     /// a result is an error and nothing is written.
     #[arg(long)]
     pub accept_poor: bool,
-    /// Leave an object cut by the volume's box open there: the faces lying
-    /// on a box face are removed, the rim stays on it (by default the
+    /// Leave an object cut by the volume's box open there: the cap on the
+    /// box face is removed and the rim moved onto the face (by default the
     /// surface closes on the box faces, as marching cubes on a padded
     /// volume does).
     #[arg(long)]

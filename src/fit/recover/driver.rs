@@ -386,8 +386,10 @@ fn voxels_outside_box(volume: &crate::volume::Volume, x: &Point3) -> Real {
         .fold(0.0, Real::max)
 }
 
-/// Mean length of the control mesh's edges at positions `p` (each face side
-/// counted once per face).
+/// Median length of the control mesh's edges at positions `p` (each face
+/// side counted once per face): a simplified cage's few long edges on flat
+/// parts would raise a mean, and with it the search range, far above the
+/// thin parts' edges.
 fn median_edge_length(mesh: &PolyMesh, p: &[Point3]) -> Real {
     let mut lengths: Vec<Real> = mesh
         .faces()
