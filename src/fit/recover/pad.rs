@@ -67,11 +67,12 @@ fn clamped(i: usize, n: usize) -> (usize, bool) {
 /// `control` (the closed result on the padded grid `padded`) opened where
 /// the box cut the object (`--open-at-box`): every face whose vertices all
 /// lie on one face of the input's box (within 1.5 voxels of it, or beyond)
-/// and that faces out through it is removed, with the vertices no face keeps. The vertices of the rim are
-/// moved onto that face (the cage lies up to a voxel or two outside the
-/// surface), so the limit surface's boundary, the B-spline of the rim
-/// (edge-and-corner rule), lies in it. Errors when no face is removed (the
-/// object does not touch the box) or every face is.
+/// and that faces out through it is removed, with the vertices no face
+/// keeps. The vertices of the rim are moved onto that face (the cage lies
+/// up to a voxel or two outside the surface), so the limit surface's
+/// boundary, the B-spline of the rim (edge-and-corner rule), lies in it.
+/// Errors when no face is removed (the object does not touch the box) or
+/// every face is.
 pub fn opened_at_box(control: &PolyMesh, padded: &Volume) -> Result<PolyMesh> {
     let dims = padded.dims();
     let index: Vec<[Real; 3]> = control
@@ -130,12 +131,13 @@ pub fn opened_at_box(control: &PolyMesh, padded: &Volume) -> Result<PolyMesh> {
     }
     if keep.len() == control.num_faces() {
         return Err(Error::Input(
-            "--open-at-box: the object does not reach the volume's box, nothing to open".into(),
+            "opening at the box: the object does not reach the volume's box, nothing to open"
+                .into(),
         ));
     }
     if keep.is_empty() {
         return Err(Error::Input(
-            "--open-at-box: the whole surface lies on the volume's box".into(),
+            "opening at the box: the whole surface lies on the volume's box".into(),
         ));
     }
     let mut new_index = vec![u32::MAX; control.num_vertices()];
