@@ -28,6 +28,8 @@ const FIT_OPTIONS: &[&str] = &[
     "refine_off_data",
     "tension",
     "bending",
+    "fairness",
+    "untangle_rounds",
     "init_resolution",
     "mass",
     "tess",
@@ -132,6 +134,8 @@ fn fit_params(o: &Options<'_, '_>) -> PyResult<FitParams> {
         refine_off_data: o.f64("refine_off_data", d.refine_off_data)?,
         tension: o.f64("tension", d.tension)?,
         bending: o.f64("bending", d.bending)?,
+        fairness: o.f64("fairness", d.fairness)?,
+        untangle_rounds: o.usize("untangle_rounds", d.untangle_rounds)?,
         mass: o.f64("mass", d.mass)?,
         ..d
     };

@@ -135,7 +135,8 @@ def fit(points: Any, normals: Any = None, **options: Any) -> FitResult:
     Options are the CLI's flags in snake_case: ``tol`` (0.1, % of the
     diagonal), ``tol_stat`` ("p95"; "max", "rms", "mean"), ``max_level`` (3),
     ``refine`` ("adaptive" or "uniform"), ``refine_significance``,
-    ``refine_off_data``, ``tension``, ``bending``, ``mass``,
+    ``refine_off_data``, ``tension``, ``bending``, ``fairness``,
+    ``untangle_rounds``, ``mass``,
     ``init`` ("auto", "closed", "open", "occupancy", or a ``(vertices,
     faces)`` control mesh), ``init_resolution``, ``tess`` (4, the limit
     surface's samples per quad edge), ``quads`` (False), and ``threads``

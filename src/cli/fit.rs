@@ -91,6 +91,15 @@ pub struct FitArgs {
     /// Bending weight λ_b of the thin plate (β = λ_b / area).
     #[arg(long, value_name = "λ", default_value_t = FitParams::default().bending)]
     pub bending: f64,
+    /// Fairness λ_u of the control net: the umbrella energy that keeps
+    /// control points from spiking out and pleating the surface (λ_u / n per
+    /// control point; 0 turns it off).
+    #[arg(long, value_name = "λ", default_value_t = FitParams::default().fairness)]
+    pub fairness: f64,
+    /// Untangling rounds per level: where the limit surface crosses itself,
+    /// smooth and stiffen the faces there and refit (0 turns it off).
+    #[arg(long, value_name = "N", default_value_t = FitParams::default().untangle_rounds)]
+    pub untangle_rounds: usize,
     /// Resolution of the automatic initial model: voxels along the longest
     /// axis of the occupancy cage, grid cells of the open grid. Holes and gaps
     /// narrower than about 4 voxels close up; raise it for thin gaps.
@@ -154,6 +163,8 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         noise_tolerance: args.noise_tol,
         tension: args.tension,
         bending: args.bending,
+        fairness: args.fairness,
+        untangle_rounds: args.untangle_rounds,
         mass: args.mass,
         ..Default::default()
     };

@@ -47,16 +47,30 @@ use crate::limit::{
 };
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
+use crate::stencil::StencilTable;
 use crate::subdivision::{
     CornerImage, Hierarchy, LocalRefinement, RefineOptions, Refiner, close_marks, refine_marked,
 };
 use crate::topology::face_of_corner;
 
 use super::init::outliers::{Screening, screen};
-use super::quality::assess;
-use super::refine_marks::{faces_above_noise, faces_off_data};
+use super::init::voxel_surface::taubin_smoothed_where;
+
+use super::fairness::{umbrella_matrix, vertex_rings};
+use super::quality::{SelfIntersections, assess};
+use super::refine_marks::{face_residuals, faces_above_noise, faces_off_data};
 use super::sampling::{shuffled_order, surface_samples, trimmed_rms};
 use super::{ErrorStats, FitParams, FitReport, LevelReport, Refinement, ToleranceStat};
+
+/// Taubin steps on the control points of the faces an untangling round
+/// marks (`FitParams::untangle_rounds`).
+const UNTANGLE_SMOOTHING_STEPS: usize = 3;
+
+/// Samples per side of every tessellation tile untangling checks: the
+/// pleats it finds are larger than a tile, and a check at this rate costs
+/// about a third of one at [`super::quality::CHECK_RATE`] (Spot, level 1:
+/// 0.35 s against 0.85 s); the report still counts at that rate.
+const UNTANGLE_CHECK_RATE: usize = 2;
 
 /// Iterations of progressive interpolation that put a locally refined
 /// level's surface on its parent's.
@@ -194,10 +208,10 @@ pub fn fit_screened_cloud(
             &material,
             params.damping / area,
         )?;
-        let [k, d] = assembly
+        let [k_base, d] = assembly
             .values_of_elements(table, |f| elements.get(f))?
             .map(|values| assembly.matrix(values));
-        let mut kd_values: Vec<Real> = k
+        let mut kd_base: Vec<Real> = k_base
             .weights
             .iter()
             .zip(&d.weights)
@@ -206,13 +220,24 @@ pub fn fit_screened_cloud(
         drop(elements);
         let m = if params.mass > 0.0 {
             let m = patch_damping_matrix(table, params.quadrature_order, params.mass / area)?;
-            for (x, y) in kd_values.iter_mut().zip(assembly.values_of(&m)?) {
+            for (x, y) in kd_base.iter_mut().zip(assembly.values_of(&m)?) {
                 *x += y;
             }
             Some(m)
         } else {
             None
         };
+        // The fairness of the control net (`FitParams::fairness`): one
+        // umbrella weight per control point, raised where untangling marks.
+        let ring = vertex_rings(&mesh);
+        let mut umbrella = vec![params.fairness / mesh.num_vertices() as Real; mesh.num_vertices()];
+        let fair = |w: &[Real]| -> Result<(StencilTable, Vec<Real>)> {
+            let u = assembly.values_of(&umbrella_matrix(&ring, w))?;
+            let kd = kd_base.iter().zip(&u).map(|(a, b)| a + b).collect();
+            let k = k_base.weights.iter().zip(&u).map(|(a, b)| a + b).collect();
+            Ok((assembly.matrix(k), kd))
+        };
+        let (mut k, mut kd_values) = fair(&umbrella)?;
         let centres = assembly.rows_at(table, &surface_samples(table, params.surface_samples))?;
         let setup_seconds = level_start.elapsed().as_secs_f64();
         let mut p = mesh.positions.clone();
@@ -236,6 +261,10 @@ pub fn fit_screened_cloud(
                 .collect()
         });
         let mut trimmed_before: Option<Real> = None;
+        // Untangling (`FitParams::untangle_rounds`): the rounds done and
+        // the step this round began at.
+        let mut untangle_round = 0;
+        let mut round_start = 0;
         let per_point = if level == 0 {
             params.first_level_points_per_control_point
         } else {
@@ -247,129 +276,154 @@ pub fn fit_screened_cloud(
             .max(4)];
         let n = used.len() as Real;
         let (used_dist, last_hints, surface_dist) = loop {
-            // Newton from the previous answers every step; every
-            // `reseed_every` steps also from the nearest seed, to catch jumps
-            // to another part of the surface.
-            let closest = match &hints {
-                Some(h) if steps % params.reseed_every != 0 => {
-                    engine.closest_points_local(used, h)?
+            let fitted = loop {
+                // Newton from the previous answers every step; every
+                // `reseed_every` steps also from the nearest seed, to catch jumps
+                // to another part of the surface.
+                let closest = match &hints {
+                    Some(h) if steps % params.reseed_every != 0 => {
+                        engine.closest_points_local(used, h)?
+                    }
+                    // A previous level's answers cover a prefix of the points;
+                    // the others start from the answer of their nearest point
+                    // in that prefix.
+                    Some(h) => {
+                        let k = h.len().min(used.len());
+                        let mut starts = h[..k].to_vec();
+                        starts.extend(nearest_answers(&used[..k], &h[..k], &used[k..]));
+                        engine.closest_points_near(used, &starts)?
+                    }
+                    None => engine.closest_points(used)?,
+                };
+                hints = Some(closest.iter().map(|c| c.patch).collect());
+                let dist: Vec<Real> = closest.iter().map(|c| c.distance).collect();
+                let w = robust_weights(&dist, params.robust, 1e-6 * diameter);
+                let kw: Vec<Real> = w.iter().map(|w| w / n).collect();
+                // RMS of the nearest 95 % of the distances: the stall test below
+                // must not be dominated by outliers (the full RMS is) nor jump as
+                // the robust weights admit or drop points (the inliers' RMS does).
+                let trimmed = trimmed_rms(&dist, 0.95);
+                // Surface-to-data springs: every surface sample to its nearest
+                // data point, so parts of the surface that no data point is
+                // closest to (bridges across gaps, flaps) are pulled onto the
+                // data too (`FitParams::surface_robust`).
+                let surface = if params.surface_weight > 0.0 {
+                    let xs = centres.rows().apply(&p)?;
+                    let near: Vec<(Point3, Real)> = xs
+                        .par_iter()
+                        .map(|x| {
+                            let nn = data_tree.nearest_one::<SquaredEuclidean>(&[x.x, x.y, x.z]);
+                            (data[nn.item as usize], nn.distance.sqrt())
+                        })
+                        .collect();
+                    let dd: Vec<Real> = near.iter().map(|n| n.1).collect();
+                    let ws = robust_weights(&dd, params.surface_robust, 1e-6 * diameter);
+                    let m = xs.len() as Real;
+                    let ks: Vec<Real> = ws.iter().map(|w| params.surface_weight * w / m).collect();
+                    let targets: Vec<Point3> = near.iter().map(|n| n.0).collect();
+                    Some((xs, targets, ks, dd))
+                } else {
+                    None
+                };
+                // The energy first (the springs' ½ k d² and ½ pᵀ K p): the
+                // systems are assembled only when another step follows.
+                let spring_energy = |d: &[Real], k: &[Real]| -> Real {
+                    d.iter().zip(k).map(|(d, k)| 0.5 * k * d * d).sum()
+                };
+                let kp = k.apply(&p)?;
+                let e = spring_energy(&dist, &kw)
+                    + surface
+                        .as_ref()
+                        .map_or(0.0, |(_, _, ks, dd)| spring_energy(dd, ks))
+                    + 0.5
+                        * kp.iter()
+                            .zip(&p)
+                            .map(|(a, b)| a.coords.dot(&b.coords))
+                            .sum::<Real>();
+                progress(level, steps, e);
+                let stats = ErrorStats::new(&dist, diameter);
+                let settled = steps > round_start
+                    && (energy.last().is_some_and(|&prev: &Real| {
+                        (prev - e).abs() <= params.energy_tolerance * prev.abs()
+                    }) || trimmed_before
+                        .is_some_and(|prev: Real| prev - trimmed <= params.error_tolerance * prev));
+                trimmed_before = Some(trimmed);
+                energy.push(e);
+                step_elapsed.push(start.elapsed().as_secs_f64());
+                step_rms_pct.push(stats.rms_pct);
+                step_p95_pct.push(stats.p95_pct);
+                if settled || steps - round_start >= params.max_steps {
+                    break (dist, hints.clone(), surface.map(|s| s.3));
                 }
-                // A previous level's answers cover a prefix of the points;
-                // the others start from the answer of their nearest point
-                // in that prefix.
-                Some(h) => {
-                    let k = h.len().min(used.len());
-                    let mut starts = h[..k].to_vec();
-                    starts.extend(nearest_answers(&used[..k], &h[..k], &used[k..]));
-                    engine.closest_points_near(used, &starts)?
+                let springs = assembly.data_springs(
+                    engine.table(),
+                    used,
+                    &closest,
+                    &kw,
+                    surface.as_ref().map(|(x, d, k, _)| RowSprings {
+                        rows: &centres,
+                        x,
+                        d,
+                        k,
+                    }),
+                )?;
+                let mut a = springs.matrix;
+                for (x, y) in a.weights.iter_mut().zip(&kd_values) {
+                    *x += y;
                 }
-                None => engine.closest_points(used)?,
-            };
-            hints = Some(closest.iter().map(|c| c.patch).collect());
-            let dist: Vec<Real> = closest.iter().map(|c| c.distance).collect();
-            let w = robust_weights(&dist, params.robust, 1e-6 * diameter);
-            let kw: Vec<Real> = w.iter().map(|w| w / n).collect();
-            // RMS of the nearest 95 % of the distances: the stall test below
-            // must not be dominated by outliers (the full RMS is) nor jump as
-            // the robust weights admit or drop points (the inliers' RMS does).
-            let trimmed = trimmed_rms(&dist, 0.95);
-            // Surface-to-data springs: every surface sample to its nearest
-            // data point, so parts of the surface that no data point is
-            // closest to (bridges across gaps, flaps) are pulled onto the
-            // data too (`FitParams::surface_robust`).
-            let surface = if params.surface_weight > 0.0 {
-                let xs = centres.rows().apply(&p)?;
-                let near: Vec<(Point3, Real)> = xs
-                    .par_iter()
-                    .map(|x| {
-                        let nn = data_tree.nearest_one::<SquaredEuclidean>(&[x.x, x.y, x.z]);
-                        (data[nn.item as usize], nn.distance.sqrt())
-                    })
-                    .collect();
-                let dd: Vec<Real> = near.iter().map(|n| n.1).collect();
-                let ws = robust_weights(&dd, params.surface_robust, 1e-6 * diameter);
-                let m = xs.len() as Real;
-                let ks: Vec<Real> = ws.iter().map(|w| params.surface_weight * w / m).collect();
-                let targets: Vec<Point3> = near.iter().map(|n| n.0).collect();
-                Some((xs, targets, ks, dd))
-            } else {
-                None
-            };
-            // The energy first (the springs' ½ k d² and ½ pᵀ K p): the
-            // systems are assembled only when another step follows.
-            let spring_energy = |d: &[Real], k: &[Real]| -> Real {
-                d.iter().zip(k).map(|(d, k)| 0.5 * k * d * d).sum()
-            };
-            let kp = k.apply(&p)?;
-            let e = spring_energy(&dist, &kw)
-                + surface
-                    .as_ref()
-                    .map_or(0.0, |(_, _, ks, dd)| spring_energy(dd, ks))
-                + 0.5
-                    * kp.iter()
-                        .zip(&p)
-                        .map(|(a, b)| a.coords.dot(&b.coords))
-                        .sum::<Real>();
-            progress(level, steps, e);
-            let stats = ErrorStats::new(&dist, diameter);
-            let settled = energy.last().is_some_and(|&prev: &Real| {
-                (prev - e).abs() <= params.energy_tolerance * prev.abs()
-            }) || trimmed_before
-                .is_some_and(|prev: Real| prev - trimmed <= params.error_tolerance * prev);
-            trimmed_before = Some(trimmed);
-            energy.push(e);
-            step_elapsed.push(start.elapsed().as_secs_f64());
-            step_rms_pct.push(stats.rms_pct);
-            step_p95_pct.push(stats.p95_pct);
-            if settled || steps >= params.max_steps {
-                break (dist, hints, surface.map(|s| s.3));
-            }
-            let springs = assembly.data_springs(
-                engine.table(),
-                used,
-                &closest,
-                &kw,
-                surface.as_ref().map(|(x, d, k, _)| RowSprings {
-                    rows: &centres,
-                    x,
-                    d,
-                    k,
-                }),
-            )?;
-            let mut a = springs.matrix;
-            for (x, y) in a.weights.iter_mut().zip(&kd_values) {
-                *x += y;
-            }
-            let dp = d.apply(&p)?;
-            let mut rhs: Vec<Point3> = springs
-                .rhs
-                .iter()
-                .zip(&dp)
-                .map(|(a, b)| Point3::from(a.coords + b.coords))
-                .collect();
-            if let Some(m) = &m {
-                let inertia: Vec<Point3> = p
+                let dp = d.apply(&p)?;
+                let mut rhs: Vec<Point3> = springs
+                    .rhs
                     .iter()
-                    .zip(&p_before)
-                    .map(|(a, b)| Point3::from(2.0 * a.coords - b.coords))
+                    .zip(&dp)
+                    .map(|(a, b)| Point3::from(a.coords + b.coords))
                     .collect();
-                for (r, x) in rhs.iter_mut().zip(m.apply(&inertia)?) {
-                    r.coords += x.coords;
+                if let Some(m) = &m {
+                    let inertia: Vec<Point3> = p
+                        .iter()
+                        .zip(&p_before)
+                        .map(|(a, b)| Point3::from(2.0 * a.coords - b.coords))
+                        .collect();
+                    for (r, x) in rhs.iter_mut().zip(m.apply(&inertia)?) {
+                        r.coords += x.coords;
+                    }
                 }
+                p_before.clone_from(&p);
+                let report = pcg(
+                    &a,
+                    &rhs,
+                    &mut p,
+                    &PcgParams {
+                        tolerance: params.cg_tolerance,
+                        ..Default::default()
+                    },
+                )?;
+                cg_iterations += report.iterations;
+                engine.set_positions(&p)?;
+                steps += 1;
+            };
+            if untangle_round >= params.untangle_rounds {
+                break fitted;
             }
+            let crossing =
+                SelfIntersections::of(&refiner, &p, UNTANGLE_CHECK_RATE)?.faces(mesh.num_faces());
+            if !crossing.contains(&true) {
+                break fitted;
+            }
+            untangle_round += 1;
+            p = untangled(
+                &mesh,
+                &ring,
+                p,
+                &crossing,
+                &mut umbrella,
+                params.untangle_stiffening,
+            );
             p_before.clone_from(&p);
-            let report = pcg(
-                &a,
-                &rhs,
-                &mut p,
-                &PcgParams {
-                    tolerance: params.cg_tolerance,
-                    ..Default::default()
-                },
-            )?;
-            cg_iterations += report.iterations;
             engine.set_positions(&p)?;
-            steps += 1;
+            (k, kd_values) = fair(&umbrella)?;
+            round_start = steps;
+            trimmed_before = None;
         };
         // The error over every point: the used points' distances are the
         // last step's (descents from the previous answers, at this surface;
@@ -537,14 +591,28 @@ pub fn fit_screened_cloud(
                         ),
                     );
                 }
-                let marks = close_marks(h.level(0), &marks);
-                let local = locally_refined(&mesh, &h, &marks)?;
+                // The worst first: webs, then by mean squared residual.
+                let residual = face_residuals(mesh.num_faces(), &face, &dist, &counted);
+                let mut rank: Vec<usize> = (0..marks.len()).filter(|&f| marks[f]).collect();
+                rank.sort_by(|&a, &b| {
+                    off_data[b]
+                        .cmp(&off_data[a])
+                        .then(residual[b].1.total_cmp(&residual[a].1))
+                        .then(a.cmp(&b))
+                });
+                let cap = params.max_control_fraction * n_all;
+                let (marks, local, left) = split_within(&mesh, &h, &rank, cap)?;
                 refinement = format!(
-                    "adaptive: {} of {} faces split{}",
+                    "adaptive: {} of {} faces split{}{}",
                     marks.iter().filter(|&&m| m).count(),
                     marks.len(),
                     if webs > 0 {
                         format!(" ({webs} with surface samples off the data)")
+                    } else {
+                        String::new()
+                    },
+                    if left > 0 {
+                        format!("; {left} more above the noise left for the control-point budget")
                     } else {
                         String::new()
                     }
@@ -594,6 +662,81 @@ pub fn fit_screened_cloud(
             seconds: start.elapsed().as_secs_f64(),
         },
     })
+}
+
+/// [`locally_refined`] with the first faces of `rank` split (closed by
+/// [`close_marks`]): all of them when the result has at most `cap` control
+/// points, else the longest prefix that keeps within it (found by
+/// bisection; the count grows with the prefix), else all of them, for the
+/// caller's budget test to stop at. Returns the closed marks, the
+/// refinement and how many ranked faces were left unsplit.
+fn split_within(
+    mesh: &PolyMesh,
+    h: &Hierarchy,
+    rank: &[usize],
+    cap: Real,
+) -> Result<(Vec<bool>, LocalRefinement, usize)> {
+    let split = |k: usize| -> Result<(Vec<bool>, LocalRefinement)> {
+        let mut marks = vec![false; mesh.num_faces()];
+        for &f in &rank[..k] {
+            marks[f] = true;
+        }
+        let marks = close_marks(h.level(0), &marks);
+        let local = locally_refined(mesh, h, &marks)?;
+        Ok((marks, local))
+    };
+    let all = split(rank.len())?;
+    if all.1.mesh.num_vertices() as Real <= cap {
+        return Ok((all.0, all.1, 0));
+    }
+    // The longest prefix within the budget: `lo` fits (or is 0), `hi` does not.
+    let (mut lo, mut hi, mut best) = (0, rank.len(), None);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        let tried = split(mid)?;
+        if tried.1.mesh.num_vertices() as Real <= cap {
+            lo = mid;
+            best = Some(tried);
+        } else {
+            hi = mid;
+        }
+    }
+    Ok(match best {
+        Some((marks, local)) => (marks, local, rank.len() - lo),
+        None => (all.0, all.1, 0),
+    })
+}
+
+/// One untangling round (`FitParams::untangle_rounds`): the control points
+/// `p` of the `crossing` faces of `mesh` (those with a tessellation triangle
+/// that crosses another) get [`UNTANGLE_SMOOTHING_STEPS`] Taubin steps, and
+/// the umbrella weights of those points and of their `ring` neighbours are
+/// multiplied by `stiffening`. Returns the smoothed points.
+fn untangled(
+    mesh: &PolyMesh,
+    ring: &[Vec<u32>],
+    p: Vec<Point3>,
+    crossing: &[bool],
+    umbrella: &mut [Real],
+    stiffening: Real,
+) -> Vec<Point3> {
+    let mut moving = vec![false; mesh.num_vertices()];
+    for f in (0..mesh.num_faces()).filter(|&f| crossing[f]) {
+        for &v in mesh.face(f) {
+            moving[v as usize] = true;
+        }
+    }
+    for (v, r) in ring.iter().enumerate() {
+        if moving[v] || r.iter().any(|&u| moving[u as usize]) {
+            umbrella[v] *= stiffening;
+        }
+    }
+    let net = PolyMesh {
+        positions: p,
+        face_offsets: mesh.face_offsets.clone(),
+        face_vertices: mesh.face_vertices.clone(),
+    };
+    taubin_smoothed_where(&net, UNTANGLE_SMOOTHING_STEPS, &moving).positions
 }
 
 /// For every query, the closest-point answer (patch and `(s, t)`) of its

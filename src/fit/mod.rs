@@ -4,6 +4,7 @@
 //! is subdivided and the fit continues at the finer level.
 
 mod driver;
+pub mod fairness;
 pub mod init;
 mod params;
 pub mod quality;

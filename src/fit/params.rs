@@ -154,6 +154,27 @@ pub struct FitParams {
     pub patch_level: usize,
     /// Gauss-Legendre points per side of every polynomial piece (default 4).
     pub quadrature_order: usize,
+    /// Weight `λ_u` of the control net's umbrella energy
+    /// ([`crate::fit::fairness`]), `λ_u / n` per control point of a level
+    /// with `n` (default 0.1, 0 turns it off): it keeps the springs from
+    /// pulling control points out into spikes, which pleat the limit
+    /// surface through itself. Chosen on the corpus's choose shapes (Spot,
+    /// fandisk, sphere, torus, plate; 0, 0.03, 0.1, 0.3 and 1 tried): 0.1
+    /// cut the self-intersections 10–30 fold and lowered the Chamfer
+    /// distance on all of them but the torus at 0.1 % noise; 1 rounds
+    /// thin parts off.
+    pub fairness: Real,
+    /// Untangling rounds per level (default 2; 0 turns it off). After a
+    /// level's steps its limit surface is tessellated and checked for
+    /// triangles that cross ([`crate::fit::quality::SelfIntersections`]);
+    /// the control points of the faces they lie on get a few Taubin
+    /// smoothing steps, their umbrella weights and their neighbours' are
+    /// multiplied by `untangle_stiffening`, and the level is refitted from
+    /// there. The next level starts from `fairness` again.
+    pub untangle_rounds: usize,
+    /// The factor by which each untangling round raises the umbrella
+    /// weights it marks (default 10; more than 1).
+    pub untangle_stiffening: Real,
 }
 
 impl Default for FitParams {
@@ -186,6 +207,9 @@ impl Default for FitParams {
             robust: RobustKernel::Huber(1.345),
             patch_level: 1,
             quadrature_order: 4,
+            fairness: 0.1,
+            untangle_rounds: 2,
+            untangle_stiffening: 10.0,
         }
     }
 }
@@ -229,10 +253,25 @@ impl FitParams {
             ("surface_weight", self.surface_weight),
             ("refine_significance", self.refine_significance),
             ("refine_off_data", self.refine_off_data),
+            ("fairness", self.fairness),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(name, v, "must be finite and ≥ 0");
             }
+        }
+        if !(self.untangle_stiffening.is_finite() && self.untangle_stiffening > 1.0) {
+            return bad(
+                "untangle_stiffening",
+                self.untangle_stiffening,
+                "expected a finite factor above 1",
+            );
+        }
+        if self.untangle_rounds > 10 {
+            return bad(
+                "untangle_rounds",
+                self.untangle_rounds as Real,
+                "expected 0 to 10",
+            );
         }
         if self.points_per_control_point == 0 {
             return bad("points_per_control_point", 0.0, "expected at least 1");

@@ -17,6 +17,13 @@
 //!   geometric normal points against the limit normals at all three of its
 //!   corners; a fold of the limit surface is where `Sᵤ × Sᵥ` turns over, and
 //!   the tessellation's triangles flip there.
+//! - **Self-intersections** ([`SelfIntersections`]): pairs of tessellation
+//!   triangles that share no vertex and intersect, the test of Open3D's
+//!   `is_self_intersecting()`: pleats and pinches where the surface passes
+//!   through itself without turning over at any one triangle. The fit
+//!   stiffens and refits the faces they come from
+//!   ([`FitParams::untangle_rounds`](super::FitParams::untangle_rounds));
+//!   what is left is reported.
 //!
 //! Each finding larger than its threshold becomes a one-line warning naming
 //! the size and where (the bounding box of the largest connected far
@@ -28,10 +35,15 @@ use serde::Serialize;
 
 use crate::error::Result;
 use crate::limit::tessellate;
-use crate::math::{Point3, Real, bounding_box};
+use crate::math::{Point3, Real, Vector3, bounding_box};
 use crate::mesh::PolyMesh;
+use crate::metrics::TriangleBvh;
 use crate::subdivision::{RefineOptions, Refiner};
-use crate::topology::UnionFind;
+use crate::topology::{UnionFind, face_of_corner};
+
+/// Samples per side of every tessellation tile [`assess`] checks (the
+/// default rate of `subdyn fit --limit-out`).
+pub const CHECK_RATE: usize = 4;
 
 /// "Far": more than this percentage of the bounding-box diagonal (the
 /// Hausdorff goal of a fit).
@@ -84,6 +96,10 @@ pub struct FitQuality {
     pub folded_triangles: usize,
     /// Triangles of that tessellation.
     pub triangles: usize,
+    /// Pairs of those triangles that share no vertex and intersect.
+    pub self_intersecting_pairs: usize,
+    /// Where they are.
+    pub self_intersection_region: Option<Region>,
     /// One line per finding above its threshold.
     pub warnings: Vec<String>,
 }
@@ -100,14 +116,8 @@ pub fn assess(
 ) -> Result<FitQuality> {
     let far = FAR_PCT / 100.0 * diameter;
     let refiner = Refiner::new(control, &RefineOptions::default())?;
-    let (mesh, normals) = tessellate(&refiner, &control.positions, 4)?;
-    let tris: Vec<[u32; 3]> = (0..mesh.num_faces())
-        .flat_map(|f| {
-            let v = mesh.face(f);
-            (1..v.len() - 1).map(move |i| [v[0], v[i], v[i + 1]])
-        })
-        .collect();
-    let p = &mesh.positions;
+    let sx = SelfIntersections::of(&refiner, &control.positions, CHECK_RATE)?;
+    let (tris, p, normals) = (&sx.triangles, &sx.positions, &sx.normals);
     // Per triangle: area, far from the data, folded.
     let facts: Vec<(Real, bool, bool)> = tris
         .par_iter()
@@ -124,7 +134,7 @@ pub fn assess(
     let far_area: Real = facts.iter().filter(|f| f.1).map(|f| f.0).sum();
     let far_surface_fraction = if area > 0.0 { far_area / area } else { 0.0 };
     let far_surface_region =
-        largest_region(&tris, p, &facts.iter().map(|f| f.1).collect::<Vec<_>>());
+        largest_region(tris, p, &facts.iter().map(|f| f.1).collect::<Vec<_>>());
     let far_points: Vec<Point3> = data
         .iter()
         .zip(distance)
@@ -140,6 +150,14 @@ pub fn assess(
         far_point_region: Region::of(&far_points),
         folded_triangles,
         triangles: tris.len(),
+        self_intersecting_pairs: sx.pairs.len(),
+        self_intersection_region: Region::of(
+            &sx.pairs
+                .iter()
+                .flatten()
+                .flat_map(|&t| tris[t as usize].map(|v| p[v as usize]))
+                .collect::<Vec<_>>(),
+        ),
         warnings: Vec::new(),
     };
     if q.far_surface_fraction > FAR_AREA_FRACTION {
@@ -164,7 +182,80 @@ pub fn assess(
             q.folded_triangles, q.triangles
         ));
     }
+    if q.self_intersecting_pairs > 0 {
+        q.warnings.push(format!(
+            "the limit surface intersects itself: {} pairs of its {} tessellation triangles cross, within {}",
+            q.self_intersecting_pairs,
+            q.triangles,
+            q.self_intersection_region
+                .map_or(String::new(), |r| r.describe())
+        ));
+    }
     Ok(q)
+}
+
+/// The limit surface tessellated `rate × rate` per tile ([`tessellate`]),
+/// fan-triangulated, and its self-intersecting triangle pairs
+/// ([`TriangleBvh::self_intersections`]).
+pub struct SelfIntersections {
+    /// Tessellation vertices.
+    pub positions: Vec<Point3>,
+    /// Limit normals at them.
+    pub normals: Vec<Vector3>,
+    /// Tessellation triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// The control face each triangle lies on.
+    pub face: Vec<u32>,
+    /// Intersecting pairs (indices into `triangles`).
+    pub pairs: Vec<[u32; 2]>,
+}
+
+impl SelfIntersections {
+    /// The tessellation of the limit surface of `refiner`'s mesh with
+    /// control points `positions`, and its self-intersections.
+    pub fn of(refiner: &Refiner, positions: &[Point3], rate: usize) -> Result<Self> {
+        let (mesh, normals) = tessellate(refiner, positions, rate)?;
+        let level = &refiner.level;
+        // `tessellate` gives every face one tile when all are quads, else
+        // one per corner, each rate² quads in tile order.
+        let quads = (0..level.num_faces()).all(|f| level.face_vertices(f).len() == 4);
+        let corner_face = face_of_corner(&level.face_offsets);
+        let per_tile = rate * rate;
+        let mut triangles = Vec::with_capacity(2 * mesh.num_faces());
+        let mut face = Vec::with_capacity(2 * mesh.num_faces());
+        for q in 0..mesh.num_faces() {
+            let v = mesh.face(q);
+            let tile = q / per_tile;
+            let f = if quads {
+                tile as u32
+            } else {
+                corner_face[tile]
+            };
+            for i in 1..v.len() - 1 {
+                triangles.push([v[0], v[i], v[i + 1]]);
+                face.push(f);
+            }
+        }
+        let bvh = TriangleBvh::new(mesh.positions, triangles)?;
+        let pairs = bvh.self_intersections();
+        Ok(SelfIntersections {
+            positions: bvh.positions().to_vec(),
+            normals,
+            triangles: bvh.triangles().to_vec(),
+            face,
+            pairs,
+        })
+    }
+
+    /// Per control face of the mesh (`num_faces` of them): whether a
+    /// triangle on it takes part in a self-intersection.
+    pub fn faces(&self, num_faces: usize) -> Vec<bool> {
+        let mut out = vec![false; num_faces];
+        for &t in self.pairs.iter().flatten() {
+            out[self.face[t as usize] as usize] = true;
+        }
+        out
+    }
 }
 
 /// The bounding box of the largest (by triangle count) connected set of

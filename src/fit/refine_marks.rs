@@ -42,22 +42,35 @@ pub fn faces_above_noise(
     let mid = inliers.len() / 2;
     let median = *inliers.select_nth_unstable_by(mid, Real::total_cmp).1;
     let sigma = (median / 0.6745).min(data_noise);
-    let mut count = vec![0usize; num_faces];
-    let mut sum = vec![0.0; num_faces];
-    for ((&f, &d), &w) in face.iter().zip(dist).zip(weight) {
-        if w > 0.0 && d.is_finite() {
-            count[f as usize] += 1;
-            sum[f as usize] += d * d;
-        }
-    }
-    let marks = count
+    let marks = face_residuals(num_faces, face, dist, weight)
         .iter()
-        .zip(&sum)
-        .map(|(&n, &s)| {
-            n >= MIN_POINTS && s / n as Real > sigma * sigma * (1.0 + z * (2.0 / n as Real).sqrt())
+        .map(|&(n, ms)| {
+            n >= MIN_POINTS && ms > sigma * sigma * (1.0 + z * (2.0 / n as Real).sqrt())
         })
         .collect();
     (marks, sigma)
+}
+
+/// Per control face: the number of counted points (non-zero `weight`,
+/// finite `dist`) whose closest point is on it, and their mean squared
+/// distance (0 without points); arguments as in [`faces_above_noise`].
+pub fn face_residuals(
+    num_faces: usize,
+    face: &[u32],
+    dist: &[Real],
+    weight: &[Real],
+) -> Vec<(usize, Real)> {
+    let mut out = vec![(0usize, 0.0); num_faces];
+    for ((&f, &d), &w) in face.iter().zip(dist).zip(weight) {
+        if w > 0.0 && d.is_finite() {
+            out[f as usize].0 += 1;
+            out[f as usize].1 += d * d;
+        }
+    }
+    for (n, s) in &mut out {
+        *s /= (*n).max(1) as Real;
+    }
+    out
 }
 
 /// The faces holding a surface sample whose distance to its nearest data

@@ -19,6 +19,7 @@ mod bvh_build;
 mod bvh_closest;
 mod bvh_collapse;
 mod bvh_ray;
+mod bvh_segment;
 mod compare;
 mod sampling;
 mod stats;

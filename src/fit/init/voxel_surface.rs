@@ -70,6 +70,12 @@ pub fn boundary_quads(grid: &VoxelGrid, corner: impl Fn([usize; 3]) -> Point3) -
 /// the negative step undoes the shrinkage of plain Laplacian smoothing, so the
 /// cage loses its staircase but keeps its size.
 pub fn taubin_smoothed(mesh: &PolyMesh, steps: usize) -> PolyMesh {
+    taubin_smoothed_where(mesh, steps, &vec![true; mesh.num_vertices()])
+}
+
+/// [`taubin_smoothed`] moving only the vertices `v` with `moving[v]` (the
+/// others stay, and their neighbours still see them).
+pub fn taubin_smoothed_where(mesh: &PolyMesh, steps: usize, moving: &[bool]) -> PolyMesh {
     const LAMBDA: Real = 0.5;
     const MU: Real = -0.53;
     let nv = mesh.num_vertices();
@@ -99,7 +105,7 @@ pub fn taubin_smoothed(mesh: &PolyMesh, steps: usize) -> PolyMesh {
                     mean - p[v].coords
                 })
                 .collect();
-            for (q, d) in p.iter_mut().zip(&delta) {
+            for ((q, d), _) in p.iter_mut().zip(&delta).zip(moving).filter(|(_, m)| **m) {
                 *q += d * factor;
             }
         }
