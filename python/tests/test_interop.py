@@ -94,14 +94,12 @@ def test_subdivided_limit_meshes(tmp_path, fmt, capfd):
 
 # Control meshes are polygon meshes (the surface is defined by them, so
 # they are not triangulated). These readers of triangle meshes do not all
-# take polygons: Open3D skips every non-triangle face of an OBJ and fails
-# on a non-convex polygon of a PLY/OFF; trimesh fails on a binary PLY or an
-# OFF whose faces have different sizes; pymeshlab drops some non-convex
-# polygons of an OFF. The tests below pin down exactly which combinations
-# work, so a change on either side shows.
+# take polygons: Open3D skips every non-triangle face of an OBJ; trimesh
+# fails on a binary PLY or an OFF whose faces have different sizes. The
+# tests below pin down exactly which combinations work, so a change on
+# either side shows.
 QUAD_FAILURES = {("open3d", "obj")}
-POLYGON_FAILURES = {("open3d", "obj"), ("open3d", "ply"), ("open3d", "off"),
-                    ("trimesh", "ply"), ("trimesh", "off"), ("pymeshlab", "off")}
+POLYGON_FAILURES = QUAD_FAILURES | {("trimesh", "ply"), ("trimesh", "off")}
 
 
 def check_control_mesh(path, fmt, capfd, failures):
@@ -126,7 +124,7 @@ def test_all_quad_control_meshes(tmp_path, fmt, capfd):
 @pytest.fixture(scope="module")
 def polygon_control(tmp_path_factory):
     """The control mesh of `subdyn fit` on the demo scan: adaptive
-    refinement leaves pentagons and hexagons, some non-convex."""
+    refinement leaves pentagons and hexagons."""
     path = tmp_path_factory.mktemp("control") / "spot.obj"
     run("subdyn", "fit", "-o", path, "--quiet")
     return subdyn.read_mesh(path)
@@ -137,6 +135,19 @@ def test_fitted_control_meshes(tmp_path, polygon_control, fmt, capfd):
     v, f = polygon_control
     assert {len(x) for x in f} > {4}
     out = tmp_path / f"control.{fmt}"
+    subdyn.write_mesh(out, v, f)
+    check_control_mesh(out, fmt, capfd, POLYGON_FAILURES)
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_non_convex_control_meshes(tmp_path, fmt, capfd):
+    # A closed prism over an L-shaped hexagon: two non-convex hexagons and
+    # six quads.
+    base = np.array([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]], dtype=float)
+    v = np.vstack([np.c_[base, np.zeros(6)], np.c_[base, np.ones(6)]])
+    f = [np.arange(6)[::-1], np.arange(6, 12)]
+    f += [np.array([i, (i + 1) % 6, (i + 1) % 6 + 6, i + 6]) for i in range(6)]
+    out = tmp_path / f"prism.{fmt}"
     subdyn.write_mesh(out, v, f)
     check_control_mesh(out, fmt, capfd, POLYGON_FAILURES)
 
