@@ -668,3 +668,62 @@ fn arch_keeps_the_gap_between_its_legs_open() {
     let (webbed, _) = build("arch, refinement off", &pts, &occupancy(1.0));
     assert!(in_gap(&webbed) > 0, "expected a web without refinement");
 }
+
+/// Points uniformly (by area) on the surface of the union of axis-aligned
+/// boxes `(lo, hi)`: each box's faces sampled by area, points inside another
+/// box dropped.
+fn boxes_cloud(boxes: &[([Real; 3], [Real; 3])], n: usize, seed: u64) -> Vec<Point3> {
+    let mut rng = Rng(seed);
+    let area = |(lo, hi): &([Real; 3], [Real; 3])| {
+        let e = [0, 1, 2].map(|k| hi[k] - lo[k]);
+        2.0 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0])
+    };
+    let total: Real = boxes.iter().map(area).sum();
+    let inside = |p: &[Real; 3], (lo, hi): &([Real; 3], [Real; 3])| {
+        (0..3).all(|k| p[k] > lo[k] && p[k] < hi[k])
+    };
+    let mut pts = Vec::with_capacity(n);
+    while pts.len() < n {
+        let mut pick = rng.range(0.0, total);
+        let b = boxes
+            .iter()
+            .find(|b| {
+                pick -= area(b);
+                pick < 0.0
+            })
+            .unwrap_or(&boxes[0]);
+        let (lo, hi) = b;
+        let e = [0, 1, 2].map(|k| hi[k] - lo[k]);
+        let faces = [e[1] * e[2], e[2] * e[0], e[0] * e[1]];
+        let mut f = rng.range(0.0, faces.iter().sum());
+        let axis = (0..3)
+            .find(|&k| {
+                f -= faces[k];
+                f < 0.0
+            })
+            .unwrap_or(2);
+        let mut p = [0, 1, 2].map(|k| rng.range(lo[k], hi[k]));
+        p[axis] = if rng.next() < 0.5 { lo[axis] } else { hi[axis] };
+        if !boxes.iter().any(|o| inside(&p, o)) {
+            pts.push(Point3::new(p[0], p[1], p[2]));
+        }
+    }
+    pts
+}
+
+#[test]
+fn occupancy_keeps_separate_thin_parts_apart() {
+    // A stool: a seat 2 × 2 × 0.12 on four legs 0.1 thick and 1.2 long, the
+    // legs 1.8 apart. Lines through two legs meet them as two thin sheets
+    // with free space between, which the interior probes take for a leak;
+    // a closing would web the legs together.
+    let mut boxes = vec![([-1.0, -1.0, 0.0], [1.0, 1.0, 0.12])];
+    for (x, y) in [(-1.0, -1.0), (0.9, -1.0), (-1.0, 0.9), (0.9, 0.9)] {
+        boxes.push(([x, y, -1.2], [x + 0.1, y + 0.1, 0.0]));
+    }
+    let pts = boxes_cloud(&boxes, 12_000, 5);
+    let (mesh, report) = build("stool", &pts, &InitParams::default());
+    assert_eq!(report.chosen, InitKind::Occupancy);
+    assert!(report.reason.contains("closing 0"), "{}", report.reason);
+    assert_closed_topology("stool", &mesh, 0);
+}
