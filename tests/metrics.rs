@@ -353,6 +353,54 @@ fn ray_cast_matches_brute_force() {
     }
 }
 
+/// The pairs of triangles that share no vertex and of which one has an edge
+/// (from its lower vertex index) crossing the other, by testing all pairs.
+fn brute_self_intersections(bvh: &TriangleBvh) -> Vec<[u32; 2]> {
+    let (p, tris) = (bvh.positions(), bvh.triangles());
+    let crosses = |s: [u32; 3], t: [u32; 3]| {
+        (0..3).any(|e| {
+            let (a, b) = (s[e].min(s[(e + 1) % 3]), s[e].max(s[(e + 1) % 3]));
+            let [x, y, z] = t.map(|v| p[v as usize]);
+            let dir = p[b as usize] - p[a as usize];
+            dir != Vector3::zeros() && ray_triangle(p[a as usize], dir, 1.0, x, y, z).is_some()
+        })
+    };
+    let mut out = Vec::new();
+    for (i, &s) in tris.iter().enumerate() {
+        for (j, &t) in tris.iter().enumerate().skip(i + 1) {
+            if !s.iter().any(|v| t.contains(v)) && (crosses(s, t) || crosses(t, s)) {
+                out.push([i as u32, j as u32]);
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn self_intersections_match_brute_force() {
+    let mut rng = Rng(23);
+    // Soups (no shared vertices), and a crumpled grid whose triangles share
+    // vertices and edges and whose folds pass through each other.
+    let mut cases: Vec<TriangleBvh> = [(40, 0.5), (400, 0.2), (1500, 0.08)]
+        .iter()
+        .map(|&(n, size)| random_soup(&mut rng, n, size))
+        .collect();
+    let mut crumpled = grid(24, 0.0);
+    for q in &mut crumpled.positions {
+        *q += 1.5 * (rng.point(1.0) - Point3::origin());
+    }
+    cases.push(TriangleBvh::from_mesh(&crumpled).unwrap());
+    for bvh in &cases {
+        let want = brute_self_intersections(bvh);
+        assert!(
+            want.len() >= 5,
+            "{} pairs: the case must intersect",
+            want.len()
+        );
+        assert_eq!(bvh.self_intersections(), want);
+    }
+}
+
 #[test]
 fn rays_through_shared_edges_and_vertices_hit_a_closed_mesh() {
     // Every ray from the cube's centre through an edge midpoint or a corner

@@ -5,14 +5,16 @@
 //! test", *JGT* 2(2), 1997, §2: the intersection segment of the two planes
 //! is bounded by edge crossings). So the pairs of a mesh's triangles that
 //! share no vertex and intersect, the pairs Open3D's
-//! `get_self_intersecting_triangles()` reports, are found by casting every
-//! triangle edge as a segment through the hierarchy: `O(n log n)` instead of
-//! the `n²` pair tests. Coplanar overlaps are not found (the crossing test
-//! [`ray_triangle`] skips segments parallel to a triangle).
+//! `get_self_intersecting_triangles()` reports, are found by testing every
+//! triangle's edges against the triangles whose boxes overlap its own. The
+//! candidates are gathered once per leaf of the hierarchy, with the leaf's
+//! box: `O(n log n)` instead of the `n²` pair tests, and a few traversals
+//! per leaf instead of one per edge. Coplanar overlaps are not found (the
+//! crossing test [`ray_triangle`] skips segments parallel to a triangle).
 
 use rayon::prelude::*;
 
-use crate::math::{Point3, Vector3};
+use crate::math::{Point3, Real, Vector3};
 
 use super::bvh::{STACK, TriangleBvh};
 use super::bvh_collapse::EMPTY;
@@ -39,11 +41,9 @@ impl TriangleBvh {
     /// # Ok::<(), subdyn::Error>(())
     /// ```
     pub fn segment_hits(&self, a: Point3, b: Point3, out: &mut Vec<usize>) {
-        let dir = b - a;
-        let finite = |v: &Vector3| v.iter().all(|c| c.is_finite());
-        if !finite(&a.coords) || !finite(&dir) || dir == Vector3::zeros() {
+        let Some((a, dir)) = segment(a, b) else {
             return;
-        }
+        };
         let inv = dir.map(|d| 1.0 / d);
         let o = Vector3::new(
             a.x - self.origin[0],
@@ -101,40 +101,103 @@ impl TriangleBvh {
     /// ```
     pub fn self_intersections(&self) -> Vec<[u32; 2]> {
         let tris = self.triangles();
-        // Every edge once, with the (one or two) triangles it bounds.
-        let mut edges: Vec<([u32; 2], u32)> = tris
+        let leaves: Vec<(usize, usize)> = self
+            .nodes
             .iter()
             .enumerate()
-            .flat_map(|(t, v)| {
-                (0..3).map(move |e| {
-                    let (a, b) = (v[e], v[(e + 1) % 3]);
-                    ([a.min(b), a.max(b)], t as u32)
-                })
+            .flat_map(|(n, node)| {
+                (0..4)
+                    .filter(move |&i| node.child[i] != EMPTY && node.count[i] > 0)
+                    .map(move |i| (n, i))
             })
             .collect();
-        edges.par_sort_unstable();
-        let runs: Vec<&[([u32; 2], u32)]> = edges.chunk_by(|x, y| x.0 == y.0).collect();
-        let mut pairs: Vec<[u32; 2]> = runs
+        // The boxes are widened by far more than the crossing test's slack
+        // (`RAY_BARY_SLACK` of a triangle's size): the candidates are a
+        // superset of the triangles an edge can cross.
+        let margin = 1e-9 * self.extent.max(Real::MIN_POSITIVE);
+        let exact_box = |c: &[Point3; 3]| {
+            let lo = [0, 1, 2].map(|k| c[0][k].min(c[1][k]).min(c[2][k]) - margin);
+            let hi = [0, 1, 2].map(|k| c[0][k].max(c[1][k]).max(c[2][k]) + margin);
+            (lo, hi)
+        };
+        let mut pairs: Vec<[u32; 2]> = leaves
             .into_par_iter()
-            .flat_map_iter(|run| {
-                let [a, b] = run[0].0;
-                let mut hits = Vec::new();
-                self.segment_hits(
-                    self.positions()[a as usize],
-                    self.positions()[b as usize],
-                    &mut hits,
-                );
-                run.iter().flat_map(move |&(_, s)| {
-                    let t = tris[s as usize];
-                    hits.clone()
-                        .into_iter()
-                        .filter(move |&h| !tris[h].iter().any(|v| t.contains(v)))
-                        .map(move |h| [s.min(h as u32), s.max(h as u32)])
-                })
+            .flat_map_iter(|(n, i)| {
+                let node = &self.nodes[n];
+                let lo = [0, 1, 2].map(|k| Real::from(node.lo[k][i]) - margin);
+                let hi = [0, 1, 2].map(|k| Real::from(node.hi[k][i]) + margin);
+                let mut near = Vec::new();
+                self.slots_overlapping(&lo, &hi, &mut near);
+                let first = node.child[i] as usize;
+                let mut out = Vec::new();
+                for slot in first..first + node.count[i] as usize {
+                    let s = self.leaf_ids[slot];
+                    let ts = tris[s as usize];
+                    // Each edge from its lower vertex index, as every
+                    // triangle sharing it sees it.
+                    let edges: Vec<(Point3, Vector3)> = (0..3)
+                        .filter_map(|e| {
+                            let (a, b) = (ts[e].min(ts[(e + 1) % 3]), ts[e].max(ts[(e + 1) % 3]));
+                            segment(self.positions()[a as usize], self.positions()[b as usize])
+                        })
+                        .collect();
+                    let (slo, shi) = exact_box(&self.leaf_corners[slot]);
+                    for &other in &near {
+                        let t = self.leaf_ids[other];
+                        let [p, q, r] = self.leaf_corners[other];
+                        let (tlo, thi) = exact_box(&self.leaf_corners[other]);
+                        if (0..3).any(|k| tlo[k] > shi[k] || thi[k] < slo[k])
+                            || tris[t as usize].iter().any(|v| ts.contains(v))
+                        {
+                            continue;
+                        }
+                        if edges
+                            .iter()
+                            .any(|&(a, dir)| ray_triangle(a, dir, 1.0, p, q, r).is_some())
+                        {
+                            out.push([s.min(t), s.max(t)]);
+                        }
+                    }
+                }
+                out
             })
             .collect();
         pairs.sort_unstable();
         pairs.dedup();
         pairs
     }
+
+    /// Appends to `out` every leaf slot whose leaf box overlaps the box
+    /// `lo`–`hi` (closed, relative to the tree's origin like the node boxes).
+    fn slots_overlapping(&self, lo: &[Real; 3], hi: &[Real; 3], out: &mut Vec<usize>) {
+        let mut stack = [0u32; STACK];
+        let mut top = 1usize;
+        while top > 0 {
+            top -= 1;
+            let n = &self.nodes[stack[top] as usize];
+            for i in 0..4 {
+                if n.child[i] == EMPTY
+                    || (0..3)
+                        .any(|k| Real::from(n.lo[k][i]) > hi[k] || Real::from(n.hi[k][i]) < lo[k])
+                {
+                    continue;
+                }
+                if n.count[i] == 0 {
+                    stack[top] = n.child[i];
+                    top += 1;
+                } else {
+                    let first = n.child[i] as usize;
+                    out.extend(first..first + n.count[i] as usize);
+                }
+            }
+        }
+    }
+}
+
+/// The segment `a`–`b` as origin and direction, `None` when it has no
+/// length or is not finite.
+fn segment(a: Point3, b: Point3) -> Option<(Point3, Vector3)> {
+    let dir = b - a;
+    let finite = |v: &Vector3| v.iter().all(|c| c.is_finite());
+    (finite(&a.coords) && finite(&dir) && dir != Vector3::zeros()).then_some((a, dir))
 }
