@@ -118,46 +118,26 @@ pub fn tessellate(
             });
         }
     }
-    // Evaluate every tile's (k+1)² grid in parallel.
-    let grids: Vec<Vec<(Point3, Vector3)>> = tiles
-        .par_iter()
-        .map(|t| {
-            let mut g = Vec::with_capacity((k + 1) * (k + 1));
-            for b in 0..=k {
-                for a in 0..=k {
-                    let u = t.origin[0] + t.size * a as Real / k as Real;
-                    let v = t.origin[1] + t.size * b as Real / k as Real;
-                    let s = table.evaluate(t.face as usize, u, v)?;
-                    g.push((s.p, s.normal()));
-                }
-            }
-            Ok(g)
-        })
-        .collect::<Result<_>>()?;
-    // Weld by topological key.
+    // Weld by topological key: a sample shared by several tiles (an edge's,
+    // a corner's) is one vertex, evaluated once, in the first tile that
+    // has it.
     let mut index: HashMap<Key, u32> = HashMap::new();
-    let mut pts = Vec::new();
-    let mut normals = Vec::new();
+    // Per vertex: the tile and grid sample it is evaluated at.
+    let mut owner: Vec<(u32, u32)> = Vec::new();
     let mut faces: Vec<Vec<u32>> = Vec::with_capacity(tiles.len() * k * k);
-    for (t, grid) in tiles.iter().zip(&grids) {
-        let mut ids = vec![0u32; (k + 1) * (k + 1)];
+    let mut ids = vec![0u32; (k + 1) * (k + 1)];
+    for (t, tile) in tiles.iter().enumerate() {
         for b in 0..=k {
             for a in 0..=k {
-                let key = sample_key(t, a, b, k);
-                let (p, n) = grid[b * (k + 1) + a];
-                let id = match key {
-                    Some(key) => *index.entry(key).or_insert_with(|| {
-                        pts.push(p);
-                        normals.push(n);
-                        (pts.len() - 1) as u32
-                    }),
-                    None => {
-                        pts.push(p);
-                        normals.push(n);
-                        (pts.len() - 1) as u32
-                    }
+                let sample = b * (k + 1) + a;
+                let mut new = || {
+                    owner.push((t as u32, sample as u32));
+                    (owner.len() - 1) as u32
                 };
-                ids[b * (k + 1) + a] = id;
+                ids[sample] = match sample_key(tile, a, b, k) {
+                    Some(key) => *index.entry(key).or_insert_with(new),
+                    None => new(),
+                };
             }
         }
         for b in 0..k {
@@ -167,6 +147,19 @@ pub fn tessellate(
             }
         }
     }
+    let (pts, normals): (Vec<Point3>, Vec<Vector3>) = owner
+        .par_iter()
+        .map(|&(t, sample)| {
+            let t = &tiles[t as usize];
+            let (a, b) = (sample as usize % (k + 1), sample as usize / (k + 1));
+            let u = t.origin[0] + t.size * a as Real / k as Real;
+            let v = t.origin[1] + t.size * b as Real / k as Real;
+            let s = table.evaluate(t.face as usize, u, v)?;
+            Ok((s.p, s.normal()))
+        })
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .unzip();
     Ok((PolyMesh::from_faces(pts, &faces)?, normals))
 }
 
