@@ -9,7 +9,9 @@
 //! is cheaper than a leaf. Below [`MEDIAN_DEPTH`] levels, or when all
 //! centroids coincide, the split is the object median (so the depth stays
 //! logarithmic on any input and the traversal stack is bounded).
-//! The binary tree is then made 4-wide by `bvh_collapse`.
+//! The two children of a large range are built in parallel
+//! ([`PARALLEL_BUILD`]); the splits and the layout do not depend on the
+//! thread count. The binary tree is then made 4-wide by `bvh_collapse`.
 
 use crate::math::Real;
 
@@ -77,78 +79,85 @@ pub(crate) fn build(boxes: &[Aabb]) -> (Vec<Node>, Vec<u32>) {
         .collect();
     let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
     let mut nodes: Vec<Node> = Vec::with_capacity(boxes.len());
-    // Depth-first layout: a left child directly follows its parent; the right
-    // child's node is created only when its work item is popped, i.e. after
-    // the whole left subtree.
-    let mut stack = vec![Work {
-        parent: None,
-        start: 0,
-        end: boxes.len(),
-        depth: 0,
-    }];
-    while let Some(work) = stack.pop() {
-        let node = nodes.len();
-        nodes.push(Node {
-            bounds: Aabb::EMPTY,
-            first: 0,
-            count: 0,
-        });
-        if let Some(parent) = work.parent {
-            nodes[parent].first = node as u32;
-        }
-        let (start, end) = (work.start, work.end);
-        let mut bounds = Aabb::EMPTY;
-        let mut cbounds = Aabb::EMPTY;
-        for &t in &order[start..end] {
-            bounds.merge(&boxes[t as usize]);
-            cbounds.grow(&centroids[t as usize]);
-        }
-        nodes[node].bounds = bounds;
-        let n = end - start;
-        let split = if n <= 1 {
-            None
-        } else {
-            choose_split(
-                &mut order[start..end],
-                &centroids,
-                boxes,
-                &bounds,
-                &cbounds,
-                work.depth,
-            )
-        };
-        match split {
-            None => {
-                nodes[node].first = start as u32;
-                nodes[node].count = n as u32;
-            }
-            Some(mid) => {
-                stack.push(Work {
-                    parent: Some(node),
-                    start: start + mid,
-                    end,
-                    depth: work.depth + 1,
-                });
-                stack.push(Work {
-                    parent: None,
-                    start,
-                    end: start + mid,
-                    depth: work.depth + 1,
-                });
-            }
-        }
-    }
+    subtree(
+        &Input {
+            boxes,
+            centroids: &centroids,
+        },
+        &mut order,
+        0,
+        0,
+        &mut nodes,
+    );
     (nodes, order)
 }
 
-/// A range of `order` waiting for its node; `parent` is set for a right
-/// child (whose index the parent records), unset for a left child (which
-/// directly follows its parent) and the root.
-struct Work {
-    parent: Option<usize>,
-    start: usize,
-    end: usize,
-    depth: usize,
+/// Subtrees over at least this many triangles build their two children in
+/// parallel; the layout and the splits are those of the serial build.
+const PARALLEL_BUILD: usize = 8192;
+
+/// The triangles' boxes and their centroids.
+struct Input<'a> {
+    boxes: &'a [Aabb],
+    centroids: &'a [[Real; 3]],
+}
+
+/// Appends to `out` the subtree over `order` (the triangles from `start` of
+/// the leaf order) in depth-first layout: a node, its left subtree, its
+/// right subtree, an inner node's `first` indexing `out`.
+fn subtree(input: &Input, order: &mut [u32], start: usize, depth: usize, out: &mut Vec<Node>) {
+    let mut bounds = Aabb::EMPTY;
+    let mut cbounds = Aabb::EMPTY;
+    for &t in order.iter() {
+        bounds.merge(&input.boxes[t as usize]);
+        cbounds.grow(&input.centroids[t as usize]);
+    }
+    let n = order.len();
+    let node = out.len();
+    out.push(Node {
+        bounds,
+        first: start as u32,
+        count: n as u32,
+    });
+    let split = if n <= 1 {
+        None
+    } else {
+        choose_split(
+            order,
+            input.centroids,
+            input.boxes,
+            &bounds,
+            &cbounds,
+            depth,
+        )
+    };
+    let Some(mid) = split else { return };
+    out[node].count = 0;
+    let (left, right) = order.split_at_mut(mid);
+    if n < PARALLEL_BUILD {
+        subtree(input, left, start, depth + 1, out);
+        out[node].first = out.len() as u32;
+        subtree(input, right, start + mid, depth + 1, out);
+        return;
+    }
+    let part = |o: &mut [u32], s: usize| {
+        let mut nodes = Vec::with_capacity(2 * o.len() / MAX_LEAF);
+        subtree(input, o, s, depth + 1, &mut nodes);
+        nodes
+    };
+    let (l, r) = rayon::join(|| part(left, start), || part(right, start + mid));
+    let append = |out: &mut Vec<Node>, sub: Vec<Node>| {
+        let base = out.len() as u32;
+        out.extend(sub.into_iter().map(|mut x| {
+            if x.count == 0 {
+                x.first += base;
+            }
+            x
+        }));
+    };
+    append(out, l);
+    out[node].first = out.len() as u32;
+    append(out, r);
 }
 
 /// Partitions `order` and returns the size of the left part, or `None` for a leaf.
