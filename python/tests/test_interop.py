@@ -102,12 +102,32 @@ QUAD_FAILURES = {("open3d", "obj")}
 POLYGON_FAILURES = QUAD_FAILURES | {("trimesh", "ply"), ("trimesh", "off")}
 
 
-def check_control_mesh(path, fmt, capfd, failures):
+# A fitted cage's faces need not be planar. Open3D triangulates a polygon
+# by ear clipping in its plane, and a face folded so that no ear can be
+# clipped makes it refuse the whole PLY or OFF with a warning; pymeshlab's
+# OFF reader silently drops some triangles of such faces (7 of the demo
+# fit's 6,652). Whether a fit leaves such a face depends on the fit, so for
+# fitted cages these outcomes, and only these, are accepted there.
+def refused(counts, expected):
+    return "could not be decomposed into triangles" in str(counts)
+
+
+def fewer_triangles(counts, expected):
+    return isinstance(counts, tuple) and counts[0] == expected[0] and counts[1] < expected[1]
+
+
+FOLD_OUTCOMES = {("open3d", "ply"): refused, ("open3d", "off"): refused,
+                 ("pymeshlab", "off"): fewer_triangles}
+
+
+def check_control_mesh(path, fmt, capfd, failures, fold_outcomes=None):
     v, f = subdyn.read_mesh(path)
     expected = (len(v), sum(len(x) - 2 for x in f))
     for tool, counts in read_each(path, capfd).items():
         if (tool, fmt) in failures:
             assert counts != expected, f"{tool} now reads {path.name}: update the known failures"
+        elif (tool, fmt) in (fold_outcomes or {}) and counts != expected:
+            assert fold_outcomes[tool, fmt](counts, expected), f"{tool} on {path.name}: {counts}"
         else:
             assert counts == expected, f"{tool} on {path.name}: {counts}"
 
@@ -136,7 +156,7 @@ def test_fitted_control_meshes(tmp_path, polygon_control, fmt, capfd):
     assert {len(x) for x in f} > {4}
     out = tmp_path / f"control.{fmt}"
     subdyn.write_mesh(out, v, f)
-    check_control_mesh(out, fmt, capfd, POLYGON_FAILURES)
+    check_control_mesh(out, fmt, capfd, POLYGON_FAILURES, FOLD_OUTCOMES)
 
 
 @pytest.mark.parametrize("fmt", FORMATS)
