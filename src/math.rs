@@ -55,3 +55,77 @@ pub fn first_non_finite(points: &[Point3]) -> Option<usize> {
 pub fn bbox_diagonal(points: &[Point3]) -> Real {
     bounding_box(points).map_or(0.0, |(lo, hi)| (hi - lo).norm())
 }
+
+/// Twice the vector area of the polygon `face` (indices into `positions`),
+/// by Newell's method: `Σ (y_i − y_j)(z_i + z_j), …` over its edges `i → j`.
+/// Its direction is the polygon's best-fit normal (right-handed with the
+/// vertex order), also for a non-planar polygon; zero for a degenerate one
+/// (Sutherland, Sproull and Schumacker, "A characterization of ten
+/// hidden-surface algorithms", *Computing Surveys* 6(1), 1974, p. 15).
+pub fn newell_normal(positions: &[Point3], face: &[u32]) -> Vector3 {
+    let mut n = Vector3::zeros();
+    for (i, &a) in face.iter().enumerate() {
+        let (p, q) = (
+            positions[a as usize],
+            positions[face[(i + 1) % face.len()] as usize],
+        );
+        n += Vector3::new(
+            (p.y - q.y) * (p.z + q.z),
+            (p.z - q.z) * (p.x + q.x),
+            (p.x - q.x) * (p.y + q.y),
+        );
+    }
+    n
+}
+
+/// Whether the polygon `face` folds over itself: projected onto its
+/// [`newell_normal`] plane, two of its edges that do not share a corner
+/// cross, or it has no area. Such a face has no triangulation in its plane
+/// (ear clipping fails on it), which is how triangle-mesh readers such as
+/// Open3D's treat a polygon; a bow-tie quad is the simplest case.
+///
+/// ```
+/// use subdyn::math::{Point3, polygon_folds};
+/// let p = |x, y, z| Point3::new(x, y, z);
+/// // A non-convex L-shaped hexagon does not fold, nor does a saddle quad.
+/// let l = [p(0., 0., 0.), p(2., 0., 0.), p(2., 1., 0.), p(1., 1., 0.), p(1., 2., 0.), p(0., 2., 0.)];
+/// assert!(!polygon_folds(&l, &[0, 1, 2, 3, 4, 5]));
+/// let saddle = [p(0., 0., 0.), p(1., 0., 0.3), p(1., 1., 0.), p(0., 1., 0.3)];
+/// assert!(!polygon_folds(&saddle, &[0, 1, 2, 3]));
+/// // Two corners of a square swapped: a bow tie, edges 0–1 and 2–3 cross.
+/// let bow = [p(0., 0., 0.), p(1., 1., 0.1), p(1., 0., 0.), p(0., 1., 0.1)];
+/// assert!(polygon_folds(&bow, &[0, 1, 2, 3]));
+/// // A polygon with no area (all corners on a line).
+/// let line = [p(0., 0., 0.), p(1., 0., 0.), p(2., 0., 0.)];
+/// assert!(polygon_folds(&line, &[0, 1, 2]));
+/// ```
+pub fn polygon_folds(positions: &[Point3], face: &[u32]) -> bool {
+    let n = newell_normal(positions, face);
+    let Some(n) = n.try_normalize(0.0) else {
+        return true;
+    };
+    let seed = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let u = n.cross(&seed).normalize();
+    let w = n.cross(&u);
+    let q: Vec<[Real; 2]> = face
+        .iter()
+        .map(|&a| {
+            let p = positions[a as usize].coords;
+            [p.dot(&u), p.dot(&w)]
+        })
+        .collect();
+    let side = |o: [Real; 2], a: [Real; 2], b: [Real; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let k = q.len();
+    (0..k).any(|i| {
+        (i + 2..k).filter(|&j| (j + 1) % k != i).any(|j| {
+            let (a, b, c, d) = (q[i], q[(i + 1) % k], q[j], q[(j + 1) % k]);
+            side(c, d, a) * side(c, d, b) < 0.0 && side(a, b, c) * side(a, b, d) < 0.0
+        })
+    })
+}

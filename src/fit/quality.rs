@@ -25,6 +25,10 @@
 //!   ([`FitParams::untangle_rounds`](super::FitParams::untangle_rounds));
 //!   what is left is reported.
 //!
+//! - **Tangled control faces**: faces of the control mesh that fold over in
+//!   their own plane ([`polygon_folds`]): the cage is tangled there, and
+//!   triangle-mesh readers that ear-clip polygons (Open3D) refuse the file.
+//!
 //! Each finding larger than its threshold becomes a one-line warning naming
 //! the size and where (the bounding box of the largest connected far
 //! region, or of the points), printed by `subdyn fit` and kept in the report.
@@ -35,7 +39,7 @@ use serde::Serialize;
 
 use crate::error::Result;
 use crate::limit::tessellate;
-use crate::math::{Point3, Real, Vector3, bounding_box};
+use crate::math::{Point3, Real, Vector3, bounding_box, polygon_folds};
 use crate::mesh::PolyMesh;
 use crate::metrics::TriangleBvh;
 use crate::subdivision::{RefineOptions, Refiner};
@@ -100,6 +104,10 @@ pub struct FitQuality {
     pub self_intersecting_pairs: usize,
     /// Where they are.
     pub self_intersection_region: Option<Region>,
+    /// Control faces that fold over in their plane ([`polygon_folds`]).
+    pub tangled_faces: usize,
+    /// Where they are.
+    pub tangled_face_region: Option<Region>,
     /// One line per finding above its threshold.
     pub warnings: Vec<String>,
 }
@@ -143,6 +151,10 @@ pub fn assess(
         .collect();
     let far_point_fraction = far_points.len() as Real / data.len().max(1) as Real;
     let folded_triangles = facts.iter().filter(|f| f.2).count();
+    let tangled: Vec<&[u32]> = control
+        .faces()
+        .filter(|f| polygon_folds(&control.positions, f))
+        .collect();
     let mut q = FitQuality {
         far_surface_fraction,
         far_surface_region,
@@ -156,6 +168,13 @@ pub fn assess(
                 .iter()
                 .flatten()
                 .flat_map(|&t| tris[t as usize].map(|v| p[v as usize]))
+                .collect::<Vec<_>>(),
+        ),
+        tangled_faces: tangled.len(),
+        tangled_face_region: Region::of(
+            &tangled
+                .iter()
+                .flat_map(|f| f.iter().map(|&v| control.positions[v as usize]))
                 .collect::<Vec<_>>(),
         ),
         warnings: Vec::new(),
@@ -180,6 +199,16 @@ pub fn assess(
         q.warnings.push(format!(
             "the limit surface folds over: {} of {} tessellation triangles face against its normals",
             q.folded_triangles, q.triangles
+        ));
+    }
+    if q.tangled_faces > 0 {
+        q.warnings.push(format!(
+            "{} of the {} control faces fold over in their plane (a tangled cage; Open3D refuses \
+             such a control mesh as PLY or OFF), within {}",
+            q.tangled_faces,
+            control.num_faces(),
+            q.tangled_face_region
+                .map_or(String::new(), |r| r.describe())
         ));
     }
     if q.self_intersecting_pairs > 0 {

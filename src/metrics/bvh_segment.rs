@@ -50,34 +50,17 @@ impl TriangleBvh {
             a.y - self.origin[1],
             a.z - self.origin[2],
         );
-        let mut stack = [0u32; STACK];
-        let mut top = 1usize;
-        while top > 0 {
-            top -= 1;
-            let n = &self.nodes[stack[top] as usize];
-            for i in 0..4 {
-                if n.child[i] == EMPTY {
-                    continue;
-                }
-                let lo = [0, 1, 2].map(|k| f64::from(n.lo[k][i]));
-                let hi = [0, 1, 2].map(|k| f64::from(n.hi[k][i]));
-                if slab(&lo, &hi, &o, &dir, &inv, 1.0).is_none() {
-                    continue;
-                }
-                if n.count[i] == 0 {
-                    stack[top] = n.child[i];
-                    top += 1;
-                    continue;
-                }
-                let first = n.child[i] as usize;
-                for slot in first..first + n.count[i] as usize {
+        self.walk(
+            |lo, hi| slab(lo, hi, &o, &dir, &inv, 1.0).is_some(),
+            |slots| {
+                for slot in slots {
                     let [p, q, r] = self.leaf_corners[slot];
                     if ray_triangle(a, dir, 1.0, p, q, r).is_some() {
                         out.push(self.leaf_ids[slot] as usize);
                     }
                 }
-            }
-        }
+            },
+        );
     }
 
     /// The pairs `[s, t]` (`s < t`, sorted) of triangles that share no
@@ -170,24 +153,40 @@ impl TriangleBvh {
     /// Appends to `out` every leaf slot whose leaf box overlaps the box
     /// `lo`–`hi` (closed, relative to the tree's origin like the node boxes).
     fn slots_overlapping(&self, lo: &[Real; 3], hi: &[Real; 3], out: &mut Vec<usize>) {
+        self.walk(
+            |clo, chi| (0..3).all(|k| clo[k] <= hi[k] && chi[k] >= lo[k]),
+            |slots| out.extend(slots),
+        );
+    }
+
+    /// Walks the tree depth first into every child whose box (relative to
+    /// the tree's origin) `enter` accepts, handing each accepted leaf's slot
+    /// range to `leaf`.
+    fn walk(
+        &self,
+        enter: impl Fn(&[Real; 3], &[Real; 3]) -> bool,
+        mut leaf: impl FnMut(std::ops::Range<usize>),
+    ) {
         let mut stack = [0u32; STACK];
         let mut top = 1usize;
         while top > 0 {
             top -= 1;
             let n = &self.nodes[stack[top] as usize];
             for i in 0..4 {
-                if n.child[i] == EMPTY
-                    || (0..3)
-                        .any(|k| Real::from(n.lo[k][i]) > hi[k] || Real::from(n.hi[k][i]) < lo[k])
-                {
+                if n.child[i] == EMPTY {
                     continue;
                 }
+                let lo = [0, 1, 2].map(|k| Real::from(n.lo[k][i]));
+                let hi = [0, 1, 2].map(|k| Real::from(n.hi[k][i]));
+                if !enter(&lo, &hi) {
+                    continue;
+                }
+                let first = n.child[i] as usize;
                 if n.count[i] == 0 {
                     stack[top] = n.child[i];
                     top += 1;
                 } else {
-                    let first = n.child[i] as usize;
-                    out.extend(first..first + n.count[i] as usize);
+                    leaf(first..first + n.count[i] as usize);
                 }
             }
         }

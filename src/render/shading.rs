@@ -1,7 +1,7 @@
 //! Normals for shading and the lighting model: Lambert with a headlight,
 //! a little ambient light, two-sided.
 
-use crate::math::{Real, Vector3};
+use crate::math::{Real, Vector3, newell_normal};
 use crate::mesh::PolyMesh;
 
 /// Fraction of full brightness that every lit surface gets (ambient light).
@@ -52,19 +52,7 @@ pub(crate) fn lit(color: [f32; 3], brightness: f32) -> [f32; 3] {
 /// polygons get their best-fit normal; the length is the polygon's area).
 pub fn face_normals(mesh: &PolyMesh) -> Vec<Vector3> {
     mesh.faces()
-        .map(|f| {
-            let mut n = Vector3::zeros();
-            for (i, &a) in f.iter().enumerate() {
-                let b = f[(i + 1) % f.len()];
-                let (p, q) = (mesh.positions[a as usize], mesh.positions[b as usize]);
-                n += Vector3::new(
-                    (p.y - q.y) * (p.z + q.z),
-                    (p.z - q.z) * (p.x + q.x),
-                    (p.x - q.x) * (p.y + q.y),
-                );
-            }
-            n / 2.0
-        })
+        .map(|f| newell_normal(&mesh.positions, f) / 2.0)
         .collect()
 }
 

@@ -13,7 +13,7 @@
 
 use crate::error::{Error, Result};
 use crate::lattice::{BoundaryTags, Lattice, LatticeTopology, cell_volume};
-use crate::math::{Point3, Real, Vector3};
+use crate::math::{Point3, Real, Vector3, newell_normal};
 
 use super::model::Solid;
 
@@ -63,15 +63,11 @@ pub fn extrusion_offset(
     face: usize,
 ) -> Result<Vector3> {
     let l = topo.faces.row(face);
-    let mut normal = Vector3::zeros();
-    let mut centre = Vector3::zeros();
-    for i in 0..l.len() {
-        let a = positions[l[i] as usize].coords;
-        let b = positions[l[(i + 1) % l.len()] as usize].coords;
-        normal += a.cross(&b);
-        centre += a;
-    }
-    centre /= l.len() as Real;
+    let mut normal = newell_normal(positions, l);
+    let centre = l
+        .iter()
+        .fold(Vector3::zeros(), |s, &v| s + positions[v as usize].coords)
+        / l.len() as Real;
     let area = 0.5 * normal.norm();
     let cell = topo.face_cells[face][0] as usize;
     let vs = topo.cell_vertices.row(cell);

@@ -2,7 +2,7 @@
 
 use super::voxel_surface::taubin_smoothed;
 use crate::error::Result;
-use crate::math::{Point3, Real, Vector3};
+use crate::math::{Point3, Real, Vector3, newell_normal};
 use crate::mesh::PolyMesh;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZero;
@@ -71,19 +71,9 @@ pub fn vertex_normals(mesh: &PolyMesh) -> Vec<Vector3> {
 pub fn face_normals(mesh: &PolyMesh) -> Vec<Vector3> {
     mesh.faces()
         .map(|f| {
-            let mut n = Vector3::zeros();
-            for (k, &a) in f.iter().enumerate() {
-                let (p, q) = (
-                    mesh.positions[a as usize],
-                    mesh.positions[f[(k + 1) % f.len()] as usize],
-                );
-                n += Vector3::new(
-                    (p.y - q.y) * (p.z + q.z),
-                    (p.z - q.z) * (p.x + q.x),
-                    (p.x - q.x) * (p.y + q.y),
-                );
-            }
-            n.try_normalize(0.0).unwrap_or_else(Vector3::zeros)
+            newell_normal(&mesh.positions, f)
+                .try_normalize(0.0)
+                .unwrap_or_else(Vector3::zeros)
         })
         .collect()
 }

@@ -4,7 +4,7 @@
 use crate::error::{Error, Result};
 use std::f64::consts::FRAC_1_SQRT_2;
 
-use crate::math::{Real, Vector3};
+use crate::math::{Real, newell_normal};
 use crate::mesh::PolyMesh;
 use crate::volume::Volume;
 
@@ -101,15 +101,7 @@ pub fn opened_at_box(control: &PolyMesh, padded: &Volume) -> Result<PolyMesh> {
         (padded.world(e) - origin).normalize()
     };
     let faces_out = |f: &[u32], axis: usize, high: bool| {
-        // Newell's normal of the polygon.
-        let mut n = Vector3::zeros();
-        for (i, &a) in f.iter().enumerate() {
-            let (p, q) = (
-                control.positions[a as usize],
-                control.positions[f[(i + 1) % f.len()] as usize],
-            );
-            n += p.coords.cross(&q.coords);
-        }
+        let n = newell_normal(&control.positions, f);
         n.dot(&outward(axis, high)) >= FRAC_1_SQRT_2 * n.norm()
     };
     let mut keep = Vec::new();
