@@ -449,15 +449,9 @@ fn layered_fraction_separates_open_from_closed() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data beside the clone")]
 fn bunny_range_view_is_open() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/scans/bun045.ply");
-    if !path.exists() {
-        eprintln!(
-            "note: {} not found; skipping the bun045 test",
-            path.display()
-        );
-        return;
-    }
     let cloud = subdyn::io::read_points(&path).expect("read bun045");
     assert_eq!(cloud.len(), 40_097);
     let t = Instant::now();

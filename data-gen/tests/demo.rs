@@ -39,11 +39,8 @@ fn committed_demo_files_load_and_are_small() {
 }
 
 #[test]
+#[cfg_attr(not(shared_data), ignore = "needs ../shared/data beside the clone")]
 fn demo_regenerates_the_committed_files() {
-    if !root().join("../shared/data/meshes/spot.obj").exists() {
-        eprintln!("skipped: ../shared/data/meshes/spot.obj is not here");
-        return;
-    }
     let out = scratch("demo");
     let out_arg = out.to_string_lossy().into_owned();
     ok(root(), &["demo", "-o", &out_arg]);
