@@ -61,7 +61,7 @@ pub fn bbox_diagonal(points: &[Point3]) -> Real {
 /// Its direction is the polygon's best-fit normal (right-handed with the
 /// vertex order), also for a non-planar polygon; zero for a degenerate one
 /// (Sutherland, Sproull and Schumacker, "A characterization of ten
-/// hidden-surface algorithms", *Computing Surveys* 6(1), 1974, p. 15).
+/// hidden-surface algorithms", *ACM Computing Surveys* 6(1), 1974).
 pub fn newell_normal(positions: &[Point3], face: &[u32]) -> Vector3 {
     let mut n = Vector3::zeros();
     for (i, &a) in face.iter().enumerate() {
