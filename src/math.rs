@@ -104,13 +104,7 @@ pub fn polygon_folds(positions: &[Point3], face: &[u32]) -> bool {
     let Some(n) = n.try_normalize(0.0) else {
         return true;
     };
-    let seed = if n.x.abs() < 0.9 {
-        Vector3::x()
-    } else {
-        Vector3::y()
-    };
-    let u = n.cross(&seed).normalize();
-    let w = n.cross(&u);
+    let [u, w] = perpendicular_basis(&n);
     let q: Vec<[Real; 2]> = face
         .iter()
         .map(|&a| {
@@ -128,4 +122,17 @@ pub fn polygon_folds(positions: &[Point3], face: &[u32]) -> bool {
             side(c, d, a) * side(c, d, b) < 0.0 && side(a, b, c) * side(a, b, d) < 0.0
         })
     })
+}
+
+/// Two unit vectors that make a right-handed orthonormal frame with the unit
+/// vector `d`: `e1 = d × h / |d × h|` with `h` the x axis (the y axis when
+/// `d` is within about 25° of x), and `e2 = d × e1`.
+pub fn perpendicular_basis(d: &Vector3) -> [Vector3; 2] {
+    let helper = if d.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let e1 = d.cross(&helper).normalize();
+    [e1, d.cross(&e1)]
 }

@@ -19,7 +19,7 @@
 //! across `u` get the row with `f = 1`. The rows have residual 0, so they
 //! change neither `E` nor `∇E`, only the step.
 
-use crate::math::{Real, Vector3};
+use crate::math::{Real, Vector3, perpendicular_basis};
 
 /// Below this `sin θ` the plane of the two vectors is undefined.
 const STRAIGHT: Real = 1e-9;
@@ -49,14 +49,7 @@ pub fn transverse_rows(
         let f = ((theta - theta_opt) / sin).clamp(0.0, 1.0);
         [row(n, f), zero]
     } else {
-        let a = u / lu;
-        let helper = if a.x.abs() < 0.9 {
-            Vector3::x()
-        } else {
-            Vector3::y()
-        };
-        let n1 = a.cross(&helper).normalize();
-        let n2 = a.cross(&n1);
+        let [n1, n2] = perpendicular_basis(&(u / lu));
         [row(n1, 1.0), row(n2, 1.0)]
     }
 }

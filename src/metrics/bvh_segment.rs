@@ -111,6 +111,10 @@ impl TriangleBvh {
                 let hi = [0, 1, 2].map(|k| Real::from(node.hi[k][i]) + margin);
                 let mut near = Vec::new();
                 self.slots_overlapping(&lo, &hi, &mut near);
+                let near_boxes: Vec<_> = near
+                    .iter()
+                    .map(|&other| exact_box(&self.leaf_corners[other]))
+                    .collect();
                 let first = node.child[i] as usize;
                 let mut out = Vec::new();
                 for slot in first..first + node.count[i] as usize {
@@ -118,17 +122,14 @@ impl TriangleBvh {
                     let ts = tris[s as usize];
                     // Each edge from its lower vertex index, as every
                     // triangle sharing it sees it.
-                    let edges: Vec<(Point3, Vector3)> = (0..3)
-                        .filter_map(|e| {
-                            let (a, b) = (ts[e].min(ts[(e + 1) % 3]), ts[e].max(ts[(e + 1) % 3]));
-                            segment(self.positions()[a as usize], self.positions()[b as usize])
-                        })
-                        .collect();
+                    let edges: [Option<(Point3, Vector3)>; 3] = std::array::from_fn(|e| {
+                        let (a, b) = (ts[e].min(ts[(e + 1) % 3]), ts[e].max(ts[(e + 1) % 3]));
+                        segment(self.positions()[a as usize], self.positions()[b as usize])
+                    });
                     let (slo, shi) = exact_box(&self.leaf_corners[slot]);
-                    for &other in &near {
+                    for (&other, (tlo, thi)) in near.iter().zip(&near_boxes) {
                         let t = self.leaf_ids[other];
                         let [p, q, r] = self.leaf_corners[other];
-                        let (tlo, thi) = exact_box(&self.leaf_corners[other]);
                         if (0..3).any(|k| tlo[k] > shi[k] || thi[k] < slo[k])
                             || tris[t as usize].iter().any(|v| ts.contains(v))
                         {
@@ -136,6 +137,7 @@ impl TriangleBvh {
                         }
                         if edges
                             .iter()
+                            .flatten()
                             .any(|&(a, dir)| ray_triangle(a, dir, 1.0, p, q, r).is_some())
                         {
                             out.push([s.min(t), s.max(t)]);

@@ -55,7 +55,7 @@
 //! a sphere, an ellipsoid and a bulb cover 0.76–0.89 (`bun045`: 0.70).
 
 use super::frame::PrincipalFrame;
-use crate::math::{Point3, Real, Vector3};
+use crate::math::{Point3, Real, Vector3, perpendicular_basis};
 use rayon::prelude::*;
 
 /// Largest number of points examined; larger clouds are subsampled.
@@ -144,13 +144,7 @@ impl Columns {
     /// apart by more than [`sheet_gap`]`(width, radius)`; `None` when the
     /// projection is a single point.
     fn new(points: &[Vector3], d: &Vector3, columns: usize, radius: Real) -> Option<Columns> {
-        let helper = if d.x.abs() < 0.9 {
-            Vector3::x()
-        } else {
-            Vector3::y()
-        };
-        let e1 = d.cross(&helper).normalize();
-        let e = [e1, d.cross(&e1)];
+        let e = perpendicular_basis(d);
         let (mut lo, mut hi) = ([Real::INFINITY; 2], [Real::NEG_INFINITY; 2]);
         for p in points {
             for k in 0..2 {
