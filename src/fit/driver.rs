@@ -2,10 +2,7 @@
 //!
 //! At each level the control points follow the first-order (massless)
 //! dynamics `D ṗ + K p = f_p` with implicit Euler steps, the data springs
-//! treated implicitly:
-//!
-//! `(γ/Δt · D + K + Σ k JᵀJ) p⁺ = γ/Δt · D p + Σ k Jᵀ d`,
-//!
+//! treated implicitly ([`super::system::LevelSystem::step`]),
 //! refreshing every spring's closest point before each step. Each step
 //! minimises the spring + stiffness energy plus a proximal term, and the
 //! closest-point refresh can only lower the spring energy, so the energy
@@ -23,31 +20,23 @@
 //!
 //! With a mass (`FitParams::mass` > 0) the steps integrate the paper's
 //! second-order dynamics `M p̈ + D ṗ + K p = f_p` (eq. 16) by backward
-//! differences, `p̈ ≈ (p⁺ − 2p + p⁻)/Δt²`, `ṗ ≈ (p⁺ − p)/Δt`:
-//!
-//! `(μ/Δt² · M + γ/Δt · D + K + Σ k JᵀJ) p⁺ = μ/Δt² · M (2p − p⁻) + γ/Δt · D p + Σ k Jᵀ d`,
-//!
-//! unconditionally stable like the first-order step. The model then carries
-//! momentum, so the potential energy may rise for a step while it
-//! overshoots; the stop rules are the same.
+//! differences, unconditionally stable like the first-order step. The model
+//! then carries momentum, so the potential energy may rise for a step while
+//! it overshoots; the stop rules ([`super::levels`]) are the same.
 
 use std::time::Instant;
 
-use crate::dynamics::{
-    MaterialParams, PcgParams, parameter_area, patch_damping_matrix, pcg,
-    stiffness_and_damping_elements,
-};
+use crate::dynamics::{MaterialParams, PcgParams, parameter_area};
 use crate::error::{Error, Result};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
-use crate::forces::{PatchAssembly, RowSprings, robust_weights};
+use crate::forces::{RowSprings, robust_weights};
 use crate::limit::{
     ClosestPointEngine, ClosestPointParams, QuadtreeCache, interpolate_limit_points, limit_stencil,
 };
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
-use crate::stencil::StencilTable;
 use crate::subdivision::{
     CornerImage, Hierarchy, LocalRefinement, RefineOptions, Refiner, close_marks, refine_marked,
 };
@@ -57,9 +46,11 @@ use super::init::outliers::{Screening, screen};
 use super::init::voxel_surface::taubin_smoothed_where;
 
 use super::fairness::{umbrella_matrix, vertex_rings};
+use super::levels::{fitted_worse, stop_after_level};
 use super::quality::{SelfIntersections, assess};
 use super::refine_marks::{face_residuals, faces_above_noise, faces_off_data};
 use super::sampling::{shuffled_order, surface_samples, trimmed_rms};
+use super::system::LevelSystem;
 use super::{ErrorStats, FitParams, FitReport, LevelReport, Refinement, ToleranceStat};
 
 /// Taubin steps on the control points of the faces an untangling round
@@ -201,44 +192,22 @@ pub fn fit_screened_cloud(
         let table = engine.table();
         let area = parameter_area(table);
         let material = MaterialParams::thin_plate(params.tension, params.bending, area);
-        let assembly = PatchAssembly::new(table)?;
-        let elements = stiffness_and_damping_elements(
+        let mut system = LevelSystem::new(
             table,
             params.quadrature_order,
             &material,
             params.damping / area,
+            (params.mass > 0.0).then(|| params.mass / area),
+            0.0,
         )?;
-        let [k_base, d] = assembly
-            .values_of_elements(table, |f| elements.get(f))?
-            .map(|values| assembly.matrix(values));
-        let mut kd_base: Vec<Real> = k_base
-            .weights
-            .iter()
-            .zip(&d.weights)
-            .map(|(a, b)| a + b)
-            .collect();
-        drop(elements);
-        let m = if params.mass > 0.0 {
-            let m = patch_damping_matrix(table, params.quadrature_order, params.mass / area)?;
-            for (x, y) in kd_base.iter_mut().zip(assembly.values_of(&m)?) {
-                *x += y;
-            }
-            Some(m)
-        } else {
-            None
-        };
         // The fairness of the control net (`FitParams::fairness`): one
         // umbrella weight per control point, raised where untangling marks.
         let ring = vertex_rings(&mesh);
         let mut umbrella = vec![params.fairness / mesh.num_vertices() as Real; mesh.num_vertices()];
-        let fair = |w: &[Real]| -> Result<(StencilTable, Vec<Real>)> {
-            let u = assembly.values_of(&umbrella_matrix(&ring, w))?;
-            let kd = kd_base.iter().zip(&u).map(|(a, b)| a + b).collect();
-            let k = k_base.weights.iter().zip(&u).map(|(a, b)| a + b).collect();
-            Ok((assembly.matrix(k), kd))
-        };
-        let (mut k, mut kd_values) = fair(&umbrella)?;
-        let centres = assembly.rows_at(table, &surface_samples(table, params.surface_samples))?;
+        system.set_fairness(&umbrella_matrix(&ring, &umbrella))?;
+        let centres = system
+            .assembly
+            .rows_at(table, &surface_samples(table, params.surface_samples))?;
         let setup_seconds = level_start.elapsed().as_secs_f64();
         let mut p = mesh.positions.clone();
         // The previous step's positions (at rest when a level starts).
@@ -330,16 +299,11 @@ pub fn fit_screened_cloud(
                 let spring_energy = |d: &[Real], k: &[Real]| -> Real {
                     d.iter().zip(k).map(|(d, k)| 0.5 * k * d * d).sum()
                 };
-                let kp = k.apply(&p)?;
                 let e = spring_energy(&dist, &kw)
                     + surface
                         .as_ref()
                         .map_or(0.0, |(_, _, ks, dd)| spring_energy(dd, ks))
-                    + 0.5
-                        * kp.iter()
-                            .zip(&p)
-                            .map(|(a, b)| a.coords.dot(&b.coords))
-                            .sum::<Real>();
+                    + system.potential(&p)?;
                 progress(level, steps, e);
                 let stats = ErrorStats::new(&dist, diameter);
                 let settled = steps > round_start
@@ -355,7 +319,7 @@ pub fn fit_screened_cloud(
                 if settled || steps - round_start >= params.max_steps {
                     break (dist, hints.clone(), surface.map(|s| s.3));
                 }
-                let springs = assembly.data_springs(
+                let springs = system.assembly.data_springs(
                     engine.table(),
                     used,
                     &closest,
@@ -367,32 +331,11 @@ pub fn fit_screened_cloud(
                         k,
                     }),
                 )?;
-                let mut a = springs.matrix;
-                for (x, y) in a.weights.iter_mut().zip(&kd_values) {
-                    *x += y;
-                }
-                let dp = d.apply(&p)?;
-                let mut rhs: Vec<Point3> = springs
-                    .rhs
-                    .iter()
-                    .zip(&dp)
-                    .map(|(a, b)| Point3::from(a.coords + b.coords))
-                    .collect();
-                if let Some(m) = &m {
-                    let inertia: Vec<Point3> = p
-                        .iter()
-                        .zip(&p_before)
-                        .map(|(a, b)| Point3::from(2.0 * a.coords - b.coords))
-                        .collect();
-                    for (r, x) in rhs.iter_mut().zip(m.apply(&inertia)?) {
-                        r.coords += x.coords;
-                    }
-                }
-                p_before.clone_from(&p);
-                let report = pcg(
-                    &a,
-                    &rhs,
+                let report = system.step(
+                    springs,
+                    None,
                     &mut p,
+                    &mut p_before,
                     &PcgParams {
                         tolerance: params.cg_tolerance,
                         ..Default::default()
@@ -421,7 +364,7 @@ pub fn fit_screened_cloud(
             );
             p_before.clone_from(&p);
             engine.set_positions(&p)?;
-            (k, kd_values) = fair(&umbrella)?;
+            system.set_fairness(&umbrella_matrix(&ring, &umbrella))?;
             round_start = steps;
             trimmed_before = None;
         };
@@ -469,8 +412,10 @@ pub fn fit_screened_cloud(
             refinement: std::mem::take(&mut refinement),
         };
         if let (Some(parent), Some(before)) = (adaptive_parent.take(), levels.last())
-            && report.error.p95 > before.error.p95
-            && report.error.rms > before.error.rms
+            && fitted_worse(
+                (report.error.rms, report.error.p95),
+                (before.error.rms, before.error.p95),
+            )
         {
             // Transitions on a coarse mesh can bend the surface more than the
             // split faces gain; refine the parent uniformly instead.
@@ -498,42 +443,36 @@ pub fn fit_screened_cloud(
         levels.push(report);
         final_dist.clone_from(&dist);
         let stat = params.tolerance_stat;
-        if error.pct(stat) <= params.tolerance_pct {
-            break (true, format!("tolerance met at level {level}"));
-        }
         let noise_pct = 100.0 * data_noise / diameter;
-        if stat == ToleranceStat::P95
+        let met = if error.pct(stat) <= params.tolerance_pct {
+            Some(format!("tolerance met at level {level}"))
+        } else if stat == ToleranceStat::P95
             && noise_pct > 0.0
             && error.p95_pct <= params.noise_tolerance * noise_pct
         {
-            break (
-                true,
-                format!(
-                    "the 95th percentile ({:.3} %) is within {} × the estimated noise σ ({:.3} %) at level {level}: a finer level would fit the noise",
-                    error.p95_pct, params.noise_tolerance, noise_pct
-                ),
-            );
-        }
-        if level >= params.max_level {
-            break (
-                false,
-                format!("maximum level {level} reached above the tolerance"),
-            );
-        }
+            Some(format!(
+                "the 95th percentile ({:.3} %) is within {} × the estimated noise σ ({:.3} %) at level {level}: a finer level would fit the noise",
+                error.p95_pct, params.noise_tolerance, noise_pct
+            ))
+        } else {
+            None
+        };
         // The gain is judged on the tolerance's statistic (the 95th
         // percentile by default), which outliers do not dominate as they do
         // the RMS.
-        if let [.., before, last] = levels.as_slice()
-            && last.error.pct(stat) > (1.0 - params.min_level_gain) * before.error.pct(stat)
-        {
-            break (
-                false,
-                format!(
-                    "level {level} lowered the {:?} error by less than {:.0} %: a finer level would gain little",
-                    params.tolerance_stat,
-                    100.0 * params.min_level_gain
-                ),
-            );
+        let gain = match levels.as_slice() {
+            [.., before, last] => Some((last.error.pct(stat), before.error.pct(stat))),
+            _ => None,
+        };
+        if let Some(stop) = stop_after_level(
+            level,
+            met,
+            params.max_level,
+            gain,
+            params.min_level_gain,
+            &format!("{stat:?} error"),
+        ) {
+            break stop;
         }
         let h = refiner.refine_uniform(1)?;
         let next = match params.refinement {

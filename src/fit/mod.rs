@@ -6,6 +6,7 @@
 mod driver;
 pub mod fairness;
 pub mod init;
+mod levels;
 mod params;
 pub mod quality;
 pub mod recover;
@@ -13,6 +14,7 @@ pub mod refine_marks;
 mod report;
 mod sampling;
 mod start;
+mod system;
 
 pub use driver::{FitResult, fit_point_cloud, fit_screened_cloud};
 pub use params::{FitParams, Refinement, ToleranceStat};

@@ -4,24 +4,37 @@
 //! balloon force used to grow a model inside a volume). With the unnormalised
 //! normal `x_u × x_v` the area element is already included.
 
-use crate::dynamics::SampleRows;
 use crate::error::{Error, Result};
 use crate::math::{Point3, Real};
+use crate::stencil::StencilTable;
 
 /// Generalised force over the control points of pressure `pressure`
-/// (positive pushes along the outward normal `x_u × x_v`) at control
-/// positions `p`, integrated over the samples `rows`.
-pub fn inflation_force(rows: &SampleRows, p: &[Point3], pressure: Real) -> Result<Vec<Point3>> {
+/// (positive pushes along the outward normal `x_u × x_v`), integrated over
+/// samples with position rows `j`, tangents `du`, `dv` and quadrature
+/// weights `weights` (in the parameter's `du dv`).
+pub fn inflation_force(
+    j: &StencilTable,
+    du: &[Point3],
+    dv: &[Point3],
+    weights: &[Real],
+    pressure: Real,
+) -> Result<Vec<Point3>> {
     if !pressure.is_finite() {
         return Err(Error::Input(format!("pressure {pressure} is not finite")));
     }
-    let du = rows.ju.apply(p)?;
-    let dv = rows.jv.apply(p)?;
-    let f: Vec<Point3> = rows
-        .weights
+    if du.len() != weights.len() || dv.len() != weights.len() || j.num_rows() != weights.len() {
+        return Err(Error::Input(format!(
+            "inflation: {} rows, {} and {} tangents, {} weights",
+            j.num_rows(),
+            du.len(),
+            dv.len(),
+            weights.len()
+        )));
+    }
+    let f: Vec<Point3> = weights
         .iter()
-        .zip(du.iter().zip(&dv))
+        .zip(du.iter().zip(dv))
         .map(|(w, (a, b))| Point3::from(pressure * w * a.coords.cross(&b.coords)))
         .collect();
-    rows.j.apply_transpose(&f)
+    j.apply_transpose(&f)
 }

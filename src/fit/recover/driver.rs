@@ -4,8 +4,9 @@
 //! [`prepare_volume`](super::prepare_volume) smooths the volume (`G_σ * I`),
 //! computes the edge potential when edges are wanted, and fixes the
 //! intensity that separates inside from outside (the iso-value, or Otsu's
-//! threshold). [`recover_shape`] then evolves the control points with the first-order dynamics of the
-//! point-cloud fit, `(γ/Δt · D + K + Σ k JᵀJ) p⁺ = γ/Δt · D p + Σ k Jᵀ y`, the
+//! threshold). [`recover_shape`] then evolves the control points with the
+//! first-order dynamics of the point-cloud fit (the same [`LevelSystem`]
+//! and step, and the same stop rules, [`crate::fit::levels`]), the spring
 //! targets `y = x + t n` being the image boundary found along the normal of
 //! every quadrature point (see [`crate::forces::ImageField`]), with stiffness
 //! `k` proportional to the point's area. A level ends when the energy
@@ -17,16 +18,15 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::{PreparedVolume, RecoverLevel, RecoverParams, RecoverReport};
-use crate::dynamics::{
-    MaterialParams, PcgParams, patch_damping_matrix, patch_sample_rows, patch_stiffness_matrix, pcg,
-};
+use crate::dynamics::{MaterialParams, PcgParams, SampleRows, gauss_legendre, patch_sample_rows};
 use crate::error::{Error, Result};
 use crate::fit::ErrorStats;
-use crate::forces::{ImageField, Offset, inflation_force, row_springs, spread_point_springs};
+use crate::fit::levels::{fitted_worse, stop_after_level};
+use crate::fit::system::LevelSystem;
+use crate::forces::{ImageField, Offset, SpringSystem, inflation_force, spread_point_springs};
 use crate::limit::{ClosestPointEngine, ClosestPointParams, PatchTable};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::PolyMesh;
-use crate::stencil::StencilTable;
 use crate::subdivision::{RefineOptions, Refiner};
 
 /// A recovered shape and what it took.
@@ -82,30 +82,44 @@ pub fn recover_shape(
                     .into(),
             ));
         }
-        let qtable = PatchTable::new(&refiner, &mesh.positions, 1)?;
+        // Level-1 patches carry everything: the closest points of the user
+        // points, the thin plate and damping, and the image springs.
+        let mut engine = ClosestPointEngine::new(
+            &refiner,
+            &mesh.positions,
+            &ClosestPointParams {
+                level: 1,
+                ..Default::default()
+            },
+        )?;
+        let table = engine.table();
         // One set of Gauss points per level-1 patch carries both the image
         // springs and the thin plate: exact on regular patches, and near
         // irregular vertices a fixed number of exact samples instead of
         // `quadrature`'s quadtree leaves, which cost ten times more to
-        // assemble for a vanishing share of the area.
-        // First derivatives only, composed to the control points as they are
-        // evaluated: the second derivatives enter K alone, assembled patch
-        // by patch below.
-        let q = patch_sample_rows(&qtable, params.quadrature_order)?;
-        let (j, ju, jv) = (&q.j, &q.ju, &q.jv);
-        let area: Real = q.weights.iter().sum();
+        // assemble for a vanishing share of the area. The tangents give the
+        // normals; the positions are rows in the assembly's pattern.
+        let SampleRows {
+            ju, jv, weights, ..
+        } = patch_sample_rows(table, params.quadrature_order)?;
+        let area: Real = weights.iter().sum();
         let material = MaterialParams::thin_plate(params.tension, params.bending, area);
-        let k = patch_stiffness_matrix(&qtable, params.quadrature_order, &material)?;
         // Damping on the limit surface is blind to control-point modes that
         // barely move it (a checkerboard over a coarse cage); a small
         // proximal term on the control points themselves, 1 % of D's mean
         // diagonal, keeps the solves from letting them drift.
-        let d = patch_damping_matrix(&qtable, params.quadrature_order, params.damping / area)?;
-        let diag = d.diagonal();
-        let delta = 0.01 * diag.iter().sum::<Real>() / diag.len().max(1) as Real;
-        let d = d.linear_combination(1.0, &StencilTable::identity(diag.len()), delta)?;
-        let kd = k.linear_combination(1.0, &d, 1.0)?;
-        drop(qtable);
+        let system = LevelSystem::new(
+            table,
+            params.quadrature_order,
+            &material,
+            params.damping / area,
+            None,
+            0.01,
+        )?;
+        let rows = system
+            .assembly
+            .rows_at(table, &gauss_points(table, params.quadrature_order))?;
+        let j = rows.rows();
         let sample_step = 0.25 * voxel;
         let search_of = |p: &[Point3]| {
             params
@@ -117,21 +131,13 @@ pub fn recover_shape(
         } else {
             params.max_steps
         };
-        let mut engine = if points.is_empty() {
-            None
-        } else {
-            Some(ClosestPointEngine::new(
-                &refiner,
-                &mesh.positions,
-                &ClosestPointParams::default(),
-            )?)
-        };
         let point_k = vec![params.points_weight / points.len().max(1) as Real; points.len()];
         // User points pull a patch as wide as a level-0 control edge at
         // every level (each subdivision halves the edges).
         let point_radius =
             (1u64 << level.min(30)) as Real * median_edge_length(&mesh, &mesh.positions);
         let mut p = mesh.positions.clone();
+        let mut p_before = p.clone();
         let mut energy: Vec<Real> = Vec::new();
         let (mut steps, mut cg_iterations, mut still) = (0, 0, false);
         let (offsets, unresolved, search, outside_box) = loop {
@@ -160,7 +166,7 @@ pub fn recover_shape(
                             xs[i] + range * field.balloon_direction(&xs[i], &n, o == Offset::Inside)
                         }
                     };
-                    (target, da * q.weights[i], o)
+                    (target, da * weights[i], o)
                 })
                 .collect();
             let total: Real = found.iter().map(|f| f.1).sum();
@@ -181,26 +187,20 @@ pub fn recover_shape(
             }
             let targets: Vec<Point3> = found.iter().map(|f| f.0).collect();
             let kw: Vec<Real> = found.iter().map(|f| f.1 / total).collect();
-            let mut springs = row_springs(j, &xs, &targets, &kw)?;
-            if let Some(engine) = &mut engine {
+            let mut springs = system.assembly.row_springs(&rows, &xs, &targets, &kw)?;
+            if !points.is_empty() {
                 engine.set_positions(&p)?;
                 let closest = engine.closest_points(points)?;
-                springs.add(&spread_point_springs(
-                    j,
-                    &xs,
-                    points,
-                    &closest,
-                    &point_k,
-                    point_radius,
-                )?)?;
+                let spread =
+                    spread_point_springs(j, &xs, points, &closest, &point_k, point_radius)?;
+                springs.add(&SpringSystem {
+                    matrix: system
+                        .assembly
+                        .matrix(system.assembly.values_of(&spread.matrix)?),
+                    ..spread
+                })?;
             }
-            let kp = k.apply(&p)?;
-            let e = springs.energy
-                + 0.5
-                    * kp.iter()
-                        .zip(&p)
-                        .map(|(a, b)| a.coords.dot(&b.coords))
-                        .sum::<Real>();
+            let e = springs.energy + system.potential(&p)?;
             progress(level, steps, e);
             let unresolved_area: Real = found
                 .iter()
@@ -239,25 +239,27 @@ pub fn recover_shape(
                     outside_box,
                 );
             }
-            let a = kd.linear_combination(1.0, &springs.matrix, 1.0)?;
-            let dp = d.apply(&p)?;
-            let mut rhs: Vec<Point3> = springs
-                .rhs
-                .iter()
-                .zip(&dp)
-                .map(|(a, b)| Point3::from(a.coords + b.coords))
-                .collect();
-            if params.inflation != 0.0 {
-                let f = inflation_force(&q, &p, params.inflation * voxel / total)?;
-                for (r, f) in rhs.iter_mut().zip(&f) {
-                    r.coords += f.coords;
-                }
-            }
-            let before = p.clone();
-            let report = pcg(&a, &rhs, &mut p, &PcgParams::default())?;
+            let load = if params.inflation != 0.0 {
+                Some(inflation_force(
+                    j,
+                    &us,
+                    &vs,
+                    &weights,
+                    params.inflation * voxel / total,
+                )?)
+            } else {
+                None
+            };
+            let report = system.step(
+                springs,
+                load.as_deref(),
+                &mut p,
+                &mut p_before,
+                &PcgParams::default(),
+            )?;
             cg_iterations += report.iterations;
             steps += 1;
-            let moved = before
+            let moved = p_before
                 .iter()
                 .zip(&p)
                 .map(|(a, b)| (a - b).norm())
@@ -269,7 +271,7 @@ pub fn recover_shape(
             level,
             control_points: mesh.num_vertices(),
             faces: mesh.num_faces(),
-            samples: q.weights.len(),
+            samples: weights.len(),
             steps,
             cg_iterations,
             seconds: level_start.elapsed().as_secs_f64(),
@@ -283,8 +285,10 @@ pub fn recover_shape(
         // every count (a thin structure can pull the finer surface's
         // springs across itself) is dropped and the parent returned.
         if let ([.., before, last], Some(parent)) = (levels.as_slice(), &coarser)
-            && last.offsets.rms > before.offsets.rms
-            && last.offsets.p95 > before.offsets.p95
+            && fitted_worse(
+                (last.offsets.rms, last.offsets.p95),
+                (before.offsets.rms, before.offsets.p95),
+            )
             && last.unresolved >= before.unresolved
         {
             let reason = format!(
@@ -304,8 +308,8 @@ pub fn recover_shape(
                 false,
                 format!(
                     "the surface left the volume's box at level {level}: {:.0} of its {} samples lie more than 1 voxel outside",
-                    outside_box * q.weights.len() as Real,
-                    q.weights.len()
+                    outside_box * weights.len() as Real,
+                    weights.len()
                 ),
             );
         }
@@ -319,26 +323,24 @@ pub fn recover_shape(
                 ),
             );
         }
-        if offsets.p95 <= params.tolerance_voxels && unresolved < 0.01 {
-            break (true, format!("tolerance met at level {level}"));
-        }
-        if level >= params.max_level {
-            break (
-                false,
-                format!("maximum level {level} reached above the tolerance"),
-            );
-        }
-        if let [.., before, last] = levels.as_slice()
-            && last.offsets.rms > (1.0 - params.min_level_gain) * before.offsets.rms
-            && last.unresolved < 0.01
-        {
-            break (
-                false,
-                format!(
-                    "level {level} lowered the RMS offset by less than {:.0} %: finer levels would follow the noise",
-                    100.0 * params.min_level_gain
-                ),
-            );
+        let met = (offsets.p95 <= params.tolerance_voxels && unresolved < 0.01)
+            .then(|| format!("tolerance met at level {level}"));
+        // The gain counts once the surface has found its boundary.
+        let gain = match levels.as_slice() {
+            [.., before, last] if last.unresolved < 0.01 => {
+                Some((last.offsets.rms, before.offsets.rms))
+            }
+            _ => None,
+        };
+        if let Some(stop) = stop_after_level(
+            level,
+            met,
+            params.max_level,
+            gain,
+            params.min_level_gain,
+            "RMS offset",
+        ) {
+            break stop;
         }
         let edge = median_edge_length(&mesh, &mesh.positions);
         if 0.5 * edge < params.min_edge_voxels * voxel {
@@ -401,4 +403,19 @@ fn median_edge_length(mesh: &PolyMesh, p: &[Point3]) -> Real {
     }
     let mid = lengths.len() / 2;
     *lengths.select_nth_unstable_by(mid, Real::total_cmp).1
+}
+
+/// The `order × order` Gauss-Legendre points of every patch of `table`, as
+/// [`patch_sample_rows`] takes them (patch after patch, `s` outer).
+fn gauss_points(table: &PatchTable, order: usize) -> Vec<(usize, [Real; 2])> {
+    let gl = gauss_legendre(order);
+    let mut at = Vec::with_capacity(table.num_patches() * gl.len() * gl.len());
+    for f in 0..table.num_patches() {
+        for &(a, _) in &gl {
+            for &(b, _) in &gl {
+                at.push((f, [a, b]));
+            }
+        }
+    }
+    at
 }
