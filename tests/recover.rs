@@ -25,7 +25,7 @@ fn a_seed_grows_to_a_sphere_iso_surface() {
     };
     let prepared = prepare_volume(&vol, &params).unwrap();
     let init = seed_cage(c + subdyn::math::Vector3::new(2.0, -1.0, 1.0), 3.0).unwrap();
-    let out = recover_shape(&prepared, &init, &[], &params, &mut |_, _, _| {}).unwrap();
+    let out = recover_shape(&prepared, &init, &[], &[], &params, &mut |_, _, _| {}).unwrap();
     for l in &out.report.levels {
         println!(
             "level {} cps {} samples {} steps {} p95 {:.3} vox unresolved {:.3} {:.2}s",
@@ -56,7 +56,15 @@ fn a_torus_is_recovered_from_its_thresholded_component_with_edges() {
     let prepared = prepare_volume(&vol, &params).unwrap();
     let cage = component_cage(&prepared.smoothed, prepared.inside_level, true, None, 12).unwrap();
     assert_eq!(cage.genus, 1);
-    let out = recover_shape(&prepared, &cage.mesh, &[], &params, &mut |_, _, _| {}).unwrap();
+    let out = recover_shape(
+        &prepared,
+        &cage.mesh,
+        &[],
+        &cage.boundary,
+        &params,
+        &mut |_, _, _| {},
+    )
+    .unwrap();
     for l in &out.report.levels {
         println!(
             "level {} cps {} samples {} steps {} p95 {:.3} vox unresolved {:.3} {:.2}s",
@@ -96,7 +104,15 @@ fn a_rod_two_voxels_thick_is_kept_by_the_automatic_cage() {
         let prepared = prepare_volume(&vol, &params).unwrap();
         let cage = component_cage(&prepared.smoothed, 0.5, true, None, 12).unwrap();
         assert!(cage.block >= 3, "block {}", cage.block);
-        let out = recover_shape(&prepared, &cage.mesh, &[], &params, &mut |_, _, _| {}).unwrap();
+        let out = recover_shape(
+            &prepared,
+            &cage.mesh,
+            &[],
+            &cage.boundary,
+            &params,
+            &mut |_, _, _| {},
+        )
+        .unwrap();
         let refiner = Refiner::new(&out.control, &RefineOptions::default()).unwrap();
         let (tess, _) = tessellate(&refiner, &out.control.positions, 4).unwrap();
         let reach = tess
@@ -117,6 +133,62 @@ fn a_rod_two_voxels_thick_is_kept_by_the_automatic_cage() {
         assert!(mean < 0.3 && max < 1.0, "mean {mean} max {max}");
         assert!(subdyn::fit::recover::poor_result(&out.report, &params).is_empty());
     }
+}
+
+/// Two-sided forces (issue 25 item 2): started from a cage of the ball
+/// alone, the rod of the previous test is missing from the model; the
+/// image springs along the ball's normals never reach it, but the rod's
+/// iso-surface points outside the surface pull the surface out along it.
+#[test]
+fn a_part_missing_from_the_cage_grows_back_by_the_two_sided_forces() {
+    let c = Point3::new(16.0, 20.0, 20.0);
+    let (from, tip) = (Point3::new(22.0, 20.0, 20.0), Point3::new(36.0, 20.0, 20.0));
+    let sdf = move |p: Point3| {
+        let ball = (p - c).norm() - 9.0;
+        let t = ((p - from).dot(&(tip - from)) / (tip - from).norm_squared()).clamp(0.0, 1.0);
+        let rod = (p - (from + t * (tip - from))).norm() - 2.0;
+        ball.min(rod)
+    };
+    let vol = sdf_volume([42, 40, 40], [1.0; 3], sdf);
+    let reach_with = |weight: Real| {
+        let params = RecoverParams {
+            boundary: BoundaryModel::Iso { value: 0.5 },
+            two_sided_weight: weight,
+            ..Default::default()
+        };
+        let prepared = prepare_volume(&vol, &params).unwrap();
+        let boundary = component_cage(&prepared.smoothed, 0.5, true, None, 12)
+            .unwrap()
+            .boundary;
+        // The ball's cage: the rod is not in it.
+        let ball = seed_cage(c, 9.0).unwrap();
+        let out =
+            recover_shape(&prepared, &ball, &[], &boundary, &params, &mut |_, _, _| {}).unwrap();
+        let refiner = Refiner::new(&out.control, &RefineOptions::default()).unwrap();
+        let (tess, _) = tessellate(&refiner, &out.control.positions, 4).unwrap();
+        let reach = tess
+            .positions
+            .iter()
+            .map(|p| p.x)
+            .fold(Real::MIN, Real::max);
+        let last = out.report.levels.last().unwrap();
+        println!(
+            "two-sided weight {weight}: reach x = {reach:.2} (tip 38, ball 25); {} control points, {:.2} % of {} iso points unmatched; {}",
+            out.control.num_vertices(),
+            100.0 * last.unmatched,
+            last.boundary_points,
+            out.report.stop_reason
+        );
+        (reach, last.unmatched)
+    };
+    let (without, _) = reach_with(0.0);
+    let (with, unmatched) = reach_with(RecoverParams::default().two_sided_weight);
+    assert!(
+        without < 30.0,
+        "the image springs alone reached x = {without}"
+    );
+    assert!(with > 36.0, "the rod ends at x = {with}, not 38");
+    assert!(unmatched < 0.05, "{unmatched}");
 }
 
 #[test]
@@ -234,7 +306,7 @@ fn user_placed_points_pull_the_surface_where_the_image_says_otherwise() {
         let prepared = prepare_volume(&vol, &params).unwrap();
         let init = seed_cage(c, 4.0).unwrap();
         let pts = if with_points { &points[..] } else { &[] };
-        let out = recover_shape(&prepared, &init, pts, &params, &mut |_, _, _| {});
+        let out = recover_shape(&prepared, &init, pts, &[], &params, &mut |_, _, _| {});
         let out = out.unwrap_or_else(|e| panic!("weight {weight} points {with_points}: {e}"));
 
         let refiner = Refiner::new(&out.control, &RefineOptions::default()).unwrap();
@@ -261,7 +333,7 @@ fn user_placed_points_pull_the_surface_where_the_image_says_otherwise() {
     let params = RecoverParams::default();
     let prepared = prepare_volume(&vol, &params).unwrap();
     let init = seed_cage(c, 4.0).unwrap();
-    assert!(recover_shape(&prepared, &init, &bad, &params, &mut |_, _, _| {}).is_err());
+    assert!(recover_shape(&prepared, &init, &bad, &[], &params, &mut |_, _, _| {}).is_err());
 }
 
 /// One user point over a ball, recovered to level 2: the pull is spread
@@ -286,7 +358,7 @@ fn a_user_point_pulls_a_patch_not_a_spike_at_finer_levels() {
     };
     let prepared = prepare_volume(&vol, &params).unwrap();
     let init = seed_cage(c, 4.0).unwrap();
-    let out = recover_shape(&prepared, &init, &[point], &params, &mut |_, _, _| {}).unwrap();
+    let out = recover_shape(&prepared, &init, &[point], &[], &params, &mut |_, _, _| {}).unwrap();
     let reached = out.report.levels.len() - 1;
     let refiner = Refiner::new(&out.control, &RefineOptions::default()).unwrap();
     let (tess, _) = tessellate(&refiner, &out.control.positions, 4).unwrap();

@@ -29,7 +29,15 @@ fn a_ball_cut_by_the_box_closes_on_the_box_face() {
     let prepared = prepare_volume(&vol, &params).unwrap();
     assert_eq!(prepared.smoothed.dims(), [34, 34, 34]);
     let cage = component_cage(&prepared.smoothed, 0.5, true, None, 12).unwrap();
-    let out = recover_shape(&prepared, &cage.mesh, &[], &params, &mut |_, _, _| {}).unwrap();
+    let out = recover_shape(
+        &prepared,
+        &cage.mesh,
+        &[],
+        &cage.boundary,
+        &params,
+        &mut |_, _, _| {},
+    )
+    .unwrap();
     assert!(poor_result(&out.report, &params).is_empty());
     let refiner = Refiner::new(&out.control, &RefineOptions::default()).unwrap();
     assert!((0..refiner.level.num_edges()).all(|e| !refiner.level.is_boundary_edge(e)));
@@ -291,6 +299,8 @@ fn level(level: usize, rms: Real, unresolved: Real) -> RecoverLevel {
         unresolved,
         search_voxels: 4.0,
         outside_box: 0.0,
+        boundary_points: 0,
+        unmatched: 0.0,
     }
 }
 

@@ -54,8 +54,15 @@ fn a_sphere_cut_by_the_box_is_recovered_closed_with_its_cap_on_the_box_face() {
     let prepared = prepare_volume_owned(volume, &params).expect("prepared");
     let cage = component_cage(&prepared.smoothed, prepared.inside_level, true, None, 24)
         .expect("a cage of the cut component");
-    let out = recover_shape(&prepared, &cage.mesh, &[], &params, &mut |_, _, _| {})
-        .expect("the cut sphere is recovered without error");
+    let out = recover_shape(
+        &prepared,
+        &cage.mesh,
+        &[],
+        &cage.boundary,
+        &params,
+        &mut |_, _, _| {},
+    )
+    .expect("the cut sphere is recovered without error");
     assert!(
         poor_result(&out.report, &params).is_empty(),
         "{:?}",

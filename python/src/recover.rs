@@ -9,7 +9,8 @@ use pyo3::types::PyDict;
 use serde_json::json;
 
 use subdyn::fit::recover::{
-    BONE_HU, RecoverParams, RecoverStart, SKIN_HU, initial_model, opened_at_box, poor_result,
+    BONE_HU, InitialModel, RecoverParams, RecoverStart, SKIN_HU, initial_model, opened_at_box,
+    poor_result,
     prepare_volume_owned, recover_shape,
 };
 use subdyn::forces::BoundaryModel;
@@ -35,6 +36,8 @@ const RECOVER_OPTIONS: &[&str] = &[
     "resolution",
     "seed_radius",
     "points_weight",
+    "two_sided_weight",
+    "two_sided_distance",
     "bending",
     "tess",
     "quads",
@@ -80,6 +83,8 @@ pub fn recover<'py>(
         max_level: o.usize("max_level", 3)?,
         bending: o.f64("bending", d.bending)?,
         points_weight: o.f64("points_weight", d.points_weight)?,
+        two_sided_weight: o.f64("two_sided_weight", d.two_sided_weight)?,
+        two_sided_voxels: o.f64("two_sided_distance", d.two_sided_voxels)?,
         ..d
     };
     params.check().map_err(crate::arrays::py_err)?;
@@ -114,9 +119,20 @@ pub fn recover<'py>(
         let volume = Volume::new(dims, data, spacing, Point3::from(origin))?;
         let prepared = prepare_volume_owned(volume, &params)?;
         let t = Instant::now();
-        let (init, init_json) = initial_model(&prepared, &start, !dark)?;
+        let InitialModel {
+            mesh: init,
+            boundary,
+            report: init_json,
+        } = initial_model(&prepared, &start, !dark)?;
         let init_s = t.elapsed().as_secs_f64();
-        let result = recover_shape(&prepared, &init, &points, &params, &mut |_, _, _| {})?;
+        let result = recover_shape(
+            &prepared,
+            &init,
+            &points,
+            &boundary,
+            &params,
+            &mut |_, _, _| {},
+        )?;
         let problems = poor_result(&result.report, &params);
         if !problems.is_empty() && !accept_poor {
             return Err(subdyn::Error::NotConverged(format!(

@@ -115,8 +115,16 @@ pub fn bench_recover(args: &BenchRecoverArgs) -> anyhow::Result<()> {
     let mut on_step = |level: usize, step: usize, _e: f64| {
         progress.stage(format!("level {level}, step {step}"));
     };
-    let (result, evolution_peak) =
-        stage_peak(|| recover_shape(&prepared, &cage.mesh, &[], &params, &mut on_step));
+    let (result, evolution_peak) = stage_peak(|| {
+        recover_shape(
+            &prepared,
+            &cage.mesh,
+            &[],
+            &cage.boundary,
+            &params,
+            &mut on_step,
+        )
+    });
     let result = result?;
     drop(progress);
     let evolution_s: f64 = result.report.levels.iter().map(|l| l.seconds).sum();

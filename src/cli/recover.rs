@@ -95,6 +95,19 @@ pub struct RecoverArgs {
     /// Total stiffness of the --points springs relative to the image springs.
     #[arg(long, value_name = "W", default_value_t = RecoverParams::default().points_weight)]
     pub points_weight: f64,
+    /// Total stiffness of the two-sided forces relative to the image springs
+    /// (0: off). With --auto, the object's iso-surface points farther than
+    /// --two-sided-distance from the surface pull it, so a part the surface
+    /// misses (a horn tip, a leg the cage lost) is pulled out.
+    #[arg(long, value_name = "W", default_value_t = RecoverParams::default().two_sided_weight)]
+    pub two_sided_weight: f64,
+    /// How far (voxels) an iso-surface point must be from the surface to pull it.
+    #[arg(long, value_name = "VOXELS", default_value_t = RecoverParams::default().two_sided_voxels)]
+    pub two_sided_distance: f64,
+    /// Largest share of iso-surface points farther than --two-sided-distance
+    /// from the surface for the tolerance to count as met.
+    #[arg(long, value_name = "F", default_value_t = RecoverParams::default().max_unmatched)]
+    pub max_unmatched: f64,
     /// Bending weight λ_b of the thin plate.
     #[arg(long, value_name = "λ", default_value_t = RecoverParams::default().bending)]
     pub bending: f64,
@@ -190,6 +203,9 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
         max_level: args.max_level,
         bending: args.bending,
         points_weight: args.points_weight,
+        two_sided_weight: args.two_sided_weight,
+        two_sided_voxels: args.two_sided_distance,
+        max_unmatched: args.max_unmatched,
         ..Default::default()
     };
     params.check()?;
@@ -227,13 +243,17 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     progress.stage("building the initial model");
     let t = Instant::now();
     let (init, init_peak) = stage_peak(|| initial_model(args, &prepared));
-    let (init, init_json) = init?;
+    let subdyn::fit::recover::InitialModel {
+        mesh: init,
+        boundary,
+        report: init_json,
+    } = init?;
     let init_s = seconds(t);
     let mut on_step = |level: usize, step: usize, energy: f64| {
         progress.stage(format!("level {level}, step {step}: energy {energy:.4e}"));
     };
     let (result, evolution_peak) =
-        stage_peak(|| recover_shape(&prepared, &init, &points, &params, &mut on_step));
+        stage_peak(|| recover_shape(&prepared, &init, &points, &boundary, &params, &mut on_step));
     let result = result.map_err(|e| {
         anyhow::Error::new(e).context(format!("recovering from {}", args.input.display()))
     })?;
@@ -341,7 +361,7 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
 fn initial_model(
     args: &RecoverArgs,
     prepared: &PreparedVolume,
-) -> anyhow::Result<(PolyMesh, serde_json::Value)> {
+) -> anyhow::Result<subdyn::fit::recover::InitialModel> {
     let seed = args.seed.map(|s| Point3::new(s[0], s[1], s[2]));
     let start = match (&args.init, seed) {
         (Some(path), _) => RecoverStart::Mesh(read_polygon_mesh(path, args.quiet)?),
@@ -354,16 +374,18 @@ fn initial_model(
             resolution: args.resolution,
         },
     };
-    let (mesh, mut value) = subdyn::fit::recover::initial_model(prepared, &start, !args.dark)
-        .map_err(|e| match cli_wording(&e.to_string()) {
-            Some(line) => anyhow::anyhow!(line),
-            None => anyhow::Error::new(e),
+    let mut model =
+        subdyn::fit::recover::initial_model(prepared, &start, !args.dark).map_err(|e| {
+            match cli_wording(&e.to_string()) {
+                Some(line) => anyhow::anyhow!(line),
+                None => anyhow::Error::new(e),
+            }
         })?;
     if let Some(path) = &args.init {
-        value["method"] = json!("file");
-        value["path"] = json!(path.display().to_string());
+        model.report["method"] = json!("file");
+        model.report["path"] = json!(path.display().to_string());
     }
-    Ok((mesh, value))
+    Ok(model)
 }
 
 /// The library's message about the seed or the resolution in the words of

@@ -32,21 +32,17 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
 use crate::forces::{RowSprings, robust_weights};
-use crate::limit::{
-    ClosestPointEngine, ClosestPointParams, QuadtreeCache, interpolate_limit_points, limit_stencil,
-};
+use crate::limit::{ClosestPointEngine, ClosestPointParams, QuadtreeCache};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
-use crate::subdivision::{
-    CornerImage, Hierarchy, LocalRefinement, RefineOptions, Refiner, close_marks, refine_marked,
-};
+use crate::subdivision::{CornerImage, RefineOptions, Refiner};
 use crate::topology::face_of_corner;
 
 use super::init::outliers::{Screening, screen};
 use super::init::voxel_surface::taubin_smoothed_where;
 
 use super::fairness::{umbrella_matrix, vertex_rings};
-use super::levels::{fitted_worse, stop_after_level};
+use super::levels::{fitted_worse, split_within, stop_after_level};
 use super::quality::{SelfIntersections, assess};
 use super::refine_marks::{face_residuals, faces_above_noise, faces_off_data};
 use super::sampling::{shuffled_order, surface_samples, trimmed_rms};
@@ -62,10 +58,6 @@ const UNTANGLE_SMOOTHING_STEPS: usize = 3;
 /// about a third of one at [`super::quality::CHECK_RATE`] (Spot, level 1:
 /// 0.35 s against 0.85 s); the report still counts at that rate.
 const UNTANGLE_CHECK_RATE: usize = 2;
-
-/// Iterations of progressive interpolation that put a locally refined
-/// level's surface on its parent's.
-const LIMIT_ITERATIONS: usize = 60;
 
 /// A previous level's closest point carried to the next level.
 enum Carried {
@@ -603,49 +595,6 @@ pub fn fit_screened_cloud(
     })
 }
 
-/// [`locally_refined`] with the first faces of `rank` split (closed by
-/// [`close_marks`]): all of them when the result has at most `cap` control
-/// points, else the longest prefix that keeps within it (found by
-/// bisection; the count grows with the prefix), else all of them, for the
-/// caller's budget test to stop at. Returns the closed marks, the
-/// refinement and how many ranked faces were left unsplit.
-fn split_within(
-    mesh: &PolyMesh,
-    h: &Hierarchy,
-    rank: &[usize],
-    cap: Real,
-) -> Result<(Vec<bool>, LocalRefinement, usize)> {
-    let split = |k: usize| -> Result<(Vec<bool>, LocalRefinement)> {
-        let mut marks = vec![false; mesh.num_faces()];
-        for &f in &rank[..k] {
-            marks[f] = true;
-        }
-        let marks = close_marks(h.level(0), &marks);
-        let local = locally_refined(mesh, h, &marks)?;
-        Ok((marks, local))
-    };
-    let all = split(rank.len())?;
-    if all.1.mesh.num_vertices() as Real <= cap {
-        return Ok((all.0, all.1, 0));
-    }
-    // The longest prefix within the budget: `lo` fits (or is 0), `hi` does not.
-    let (mut lo, mut hi, mut best) = (0, rank.len(), None);
-    while hi - lo > 1 {
-        let mid = (lo + hi) / 2;
-        let tried = split(mid)?;
-        if tried.1.mesh.num_vertices() as Real <= cap {
-            lo = mid;
-            best = Some(tried);
-        } else {
-            hi = mid;
-        }
-    }
-    Ok(match best {
-        Some((marks, local)) => (marks, local, rank.len() - lo),
-        None => (all.0, all.1, 0),
-    })
-}
-
 /// One untangling round (`FitParams::untangle_rounds`): the control points
 /// `p` of the `crossing` faces of `mesh` (those with a tessellation triangle
 /// that crosses another) get [`UNTANGLE_SMOOTHING_STEPS`] Taubin steps, and
@@ -696,32 +645,4 @@ fn nearest_answers(
         .par_iter()
         .map(|q| answers[tree.nearest_one::<SquaredEuclidean>(&[q.x, q.y, q.z]).item as usize])
         .collect()
-}
-
-/// `mesh` with its `marked` faces split ([`refine_marked`]; `h` is one
-/// uniform refinement of it), the new control points placed so that the
-/// limit point of every vertex of a split or changed face lies on `mesh`'s
-/// limit surface where the vertex it stands for in uniform refinement has
-/// its limit point ([`interpolate_limit_points`]; the other vertices keep
-/// their positions, so the surface away from the split faces is unchanged).
-fn locally_refined(mesh: &PolyMesh, h: &Hierarchy, marked: &[bool]) -> Result<LocalRefinement> {
-    let mut local = refine_marked(mesh, h.level(0), h.stencil(0), marked)?;
-    let parent_limit = limit_stencil(h, 1)?.apply(&mesh.positions)?;
-    let targets: Vec<Point3> = local
-        .uniform_vertex
-        .iter()
-        .map(|&u| parent_limit[u as usize])
-        .collect();
-    let mut movable = vec![false; local.mesh.num_vertices()];
-    for (g, &f) in local.parent_face.iter().enumerate() {
-        let face = local.mesh.face(g);
-        if face != mesh.face(f as usize) {
-            for &v in face {
-                movable[v as usize] = true;
-            }
-        }
-    }
-    (local.mesh.positions, _) =
-        interpolate_limit_points(&local.mesh, &targets, &movable, LIMIT_ITERATIONS)?;
-    Ok(local)
 }

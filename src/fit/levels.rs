@@ -2,7 +2,15 @@
 //! volume recovery share (Qin, Mandal, Vemuri 1998, §6: the model settles
 //! at a level, and is subdivided while its error is above the tolerance).
 
-use crate::math::Real;
+use crate::error::Result;
+use crate::limit::{interpolate_limit_points, limit_stencil};
+use crate::math::{Point3, Real};
+use crate::mesh::PolyMesh;
+use crate::subdivision::{Hierarchy, LocalRefinement, close_marks, refine_marked};
+
+/// Iterations of progressive interpolation that put a locally refined
+/// level's surface on its parent's.
+const LIMIT_ITERATIONS: usize = 60;
 
 /// Whether a run stops after `level`, and why: `met` is the reason when
 /// the level meets the driver's tolerance (the run has converged); else the
@@ -44,4 +52,75 @@ pub(crate) fn stop_after_level(
 /// uniformly instead of adaptively; the recovery returns the parent.
 pub(crate) fn fitted_worse(last: (Real, Real), parent: (Real, Real)) -> bool {
     last.0 > parent.0 && last.1 > parent.1
+}
+
+/// [`locally_refined`] with the first faces of `rank` split (closed by
+/// [`close_marks`]): all of them when the result has at most `cap` control
+/// points, else the longest prefix that keeps within it (found by
+/// bisection; the count grows with the prefix), else all of them, for the
+/// caller's budget test to stop at. Returns the closed marks, the
+/// refinement and how many ranked faces were left unsplit.
+pub(crate) fn split_within(
+    mesh: &PolyMesh,
+    h: &Hierarchy,
+    rank: &[usize],
+    cap: Real,
+) -> Result<(Vec<bool>, LocalRefinement, usize)> {
+    let split = |k: usize| -> Result<(Vec<bool>, LocalRefinement)> {
+        let mut marks = vec![false; mesh.num_faces()];
+        for &f in &rank[..k] {
+            marks[f] = true;
+        }
+        let marks = close_marks(h.level(0), &marks);
+        let local = locally_refined(mesh, h, &marks)?;
+        Ok((marks, local))
+    };
+    let all = split(rank.len())?;
+    if all.1.mesh.num_vertices() as Real <= cap {
+        return Ok((all.0, all.1, 0));
+    }
+    // The longest prefix within the budget: `lo` fits (or is 0), `hi` does not.
+    let (mut lo, mut hi, mut best) = (0, rank.len(), None);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        let tried = split(mid)?;
+        if tried.1.mesh.num_vertices() as Real <= cap {
+            lo = mid;
+            best = Some(tried);
+        } else {
+            hi = mid;
+        }
+    }
+    Ok(match best {
+        Some((marks, local)) => (marks, local, rank.len() - lo),
+        None => (all.0, all.1, 0),
+    })
+}
+
+/// `mesh` with its `marked` faces split ([`refine_marked`]; `h` is one
+/// uniform refinement of it), the new control points placed so that the
+/// limit point of every vertex of a split or changed face lies on `mesh`'s
+/// limit surface where the vertex it stands for in uniform refinement has
+/// its limit point ([`interpolate_limit_points`]; the other vertices keep
+/// their positions, so the surface away from the split faces is unchanged).
+fn locally_refined(mesh: &PolyMesh, h: &Hierarchy, marked: &[bool]) -> Result<LocalRefinement> {
+    let mut local = refine_marked(mesh, h.level(0), h.stencil(0), marked)?;
+    let parent_limit = limit_stencil(h, 1)?.apply(&mesh.positions)?;
+    let targets: Vec<Point3> = local
+        .uniform_vertex
+        .iter()
+        .map(|&u| parent_limit[u as usize])
+        .collect();
+    let mut movable = vec![false; local.mesh.num_vertices()];
+    for (g, &f) in local.parent_face.iter().enumerate() {
+        let face = local.mesh.face(g);
+        if face != mesh.face(f as usize) {
+            for &v in face {
+                movable[v as usize] = true;
+            }
+        }
+    }
+    (local.mesh.positions, _) =
+        interpolate_limit_points(&local.mesh, &targets, &movable, LIMIT_ITERATIONS)?;
+    Ok(local)
 }

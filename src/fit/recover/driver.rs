@@ -15,19 +15,24 @@
 
 use std::time::Instant;
 
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
 use super::{PreparedVolume, RecoverLevel, RecoverParams, RecoverReport};
 use crate::dynamics::{MaterialParams, PcgParams, SampleRows, gauss_legendre, patch_sample_rows};
 use crate::error::{Error, Result};
 use crate::fit::ErrorStats;
-use crate::fit::levels::{fitted_worse, stop_after_level};
+use crate::fit::Refinement;
+use crate::fit::levels::{fitted_worse, split_within, stop_after_level};
 use crate::fit::system::LevelSystem;
-use crate::forces::{ImageField, Offset, SpringSystem, inflation_force, spread_point_springs};
-use crate::limit::{ClosestPointEngine, ClosestPointParams, PatchTable};
+use crate::forces::{
+    ImageField, Offset, RowSprings, SpringSystem, inflation_force, spread_point_springs,
+};
+use crate::limit::{ClosestPoint, ClosestPointEngine, ClosestPointParams, PatchTable};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::PolyMesh;
 use crate::subdivision::{RefineOptions, Refiner};
+use crate::topology::face_of_corner;
 
 /// A recovered shape and what it took.
 #[derive(Clone, Debug)]
@@ -43,17 +48,22 @@ pub struct RecoverResult {
 /// user-placed boundary points (world coordinates; may be empty), each
 /// pulling its closest point of the limit surface with a spring, for parts
 /// of the boundary the image does not show (Qin et al. 1998, the caudate
-/// nucleus). `progress(level, step, energy)` is called after every step.
+/// nucleus). `boundary` are the object's iso-surface points for the
+/// two-sided forces (`RecoverParams::two_sided_weight`; may be empty, as
+/// when the object is not known). `progress(level, step, energy)` is called
+/// after every step.
 pub fn recover_shape(
     prepared: &PreparedVolume,
     init: &PolyMesh,
     points: &[Point3],
+    boundary: &[Point3],
     params: &RecoverParams,
     progress: &mut dyn FnMut(usize, usize, Real),
 ) -> Result<RecoverResult> {
     params.check()?;
     crate::mesh::check_finite(&init.positions)?;
     crate::mesh::check_finite(points)?;
+    crate::mesh::check_finite(boundary)?;
     let start = Instant::now();
     let field = ImageField {
         smoothed: &prepared.smoothed,
@@ -93,6 +103,8 @@ pub fn recover_shape(
             },
         )?;
         let table = engine.table();
+        // A level-1 patch is corner `c` of a control face.
+        let face_of_patch = face_of_corner(&mesh.face_offsets);
         // One set of Gauss points per level-1 patch carries both the image
         // springs and the thin plate: exact on regular patches, and near
         // irregular vertices a fixed number of exact samples instead of
@@ -102,6 +114,7 @@ pub fn recover_shape(
         let SampleRows {
             ju, jv, weights, ..
         } = patch_sample_rows(table, params.quadrature_order)?;
+        let at = gauss_points(table, params.quadrature_order);
         let area: Real = weights.iter().sum();
         let material = MaterialParams::thin_plate(params.tension, params.bending, area);
         // Damping on the limit surface is blind to control-point modes that
@@ -116,9 +129,7 @@ pub fn recover_shape(
             None,
             0.01,
         )?;
-        let rows = system
-            .assembly
-            .rows_at(table, &gauss_points(table, params.quadrature_order))?;
+        let rows = system.assembly.rows_at(table, &at)?;
         let j = rows.rows();
         let sample_step = 0.25 * voxel;
         let search_of = |p: &[Point3]| {
@@ -132,6 +143,16 @@ pub fn recover_shape(
             params.max_steps
         };
         let point_k = vec![params.points_weight / points.len().max(1) as Real; points.len()];
+        // The two-sided forces' points: every `stride`-th iso-surface point,
+        // at most as many as the samples.
+        let far_from: Vec<Point3> = if params.two_sided_weight > 0.0 {
+            let stride = boundary.len().div_ceil(weights.len().max(1)).max(1);
+            boundary.iter().step_by(stride).copied().collect()
+        } else {
+            Vec::new()
+        };
+        let two_sided_k = params.two_sided_weight / far_from.len().max(1) as Real;
+        let reach = params.two_sided_voxels * voxel;
         // User points pull a patch as wide as a level-0 control edge at
         // every level (each subdivision halves the edges).
         let point_radius =
@@ -140,7 +161,7 @@ pub fn recover_shape(
         let mut p_before = p.clone();
         let mut energy: Vec<Real> = Vec::new();
         let (mut steps, mut cg_iterations, mut still) = (0, 0, false);
-        let (offsets, unresolved, search, outside_box) = loop {
+        let (offsets, unresolved, search, outside_box, unmatched, off) = loop {
             let search = search_of(&p);
             let range = search * voxel;
             let xs = j.apply(&p)?;
@@ -187,9 +208,24 @@ pub fn recover_shape(
             }
             let targets: Vec<Point3> = found.iter().map(|f| f.0).collect();
             let kw: Vec<Real> = found.iter().map(|f| f.1 / total).collect();
-            let mut springs = system.assembly.row_springs(&rows, &xs, &targets, &kw)?;
-            if !points.is_empty() {
+            if !points.is_empty() || !far_from.is_empty() {
                 engine.set_positions(&p)?;
+            }
+            let (far, far_closest) = far_points(&engine, &xs, &us, &vs, &at, &far_from, reach)?;
+            let far_k = vec![two_sided_k; far.len()];
+            let mut springs = system.assembly.data_springs(
+                engine.table(),
+                &far,
+                &far_closest,
+                &far_k,
+                Some(RowSprings {
+                    rows: &rows,
+                    x: &xs,
+                    d: &targets,
+                    k: &kw,
+                }),
+            )?;
+            if !points.is_empty() {
                 let closest = engine.closest_points(points)?;
                 let spread =
                     spread_point_springs(j, &xs, points, &closest, &point_k, point_radius)?;
@@ -232,12 +268,25 @@ pub fn recover_shape(
                 let unresolved = 1.0 - t.len() as Real / found.len() as Real;
                 let outside_box = beyond.iter().filter(|&&b| b > 1.0).count() as Real
                     / beyond.len().max(1) as Real;
-                break (
-                    ErrorStats::new(&t, bbox_diagonal(&xs) / voxel),
-                    unresolved,
-                    search,
-                    outside_box,
-                );
+                let unmatched = far.len() as Real / far_from.len().max(1) as Real;
+                // How far off the boundary each face is, for adaptive
+                // refinement: the far iso-surface points whose closest point
+                // it holds, and while the offsets' 95th percentile is above
+                // the tolerance, its samples farther from the boundary than it.
+                let mut off = vec![0usize; mesh.num_faces()];
+                let tolerance = params.tolerance_voxels * voxel;
+                let stats = ErrorStats::new(&t, bbox_diagonal(&xs) / voxel);
+                if stats.p95 > params.tolerance_voxels {
+                    for (f, o) in at.iter().zip(&found) {
+                        if matches!(o.2, Offset::Boundary(t) if t.abs() > tolerance) {
+                            off[face_of_patch[f.0] as usize] += 1;
+                        }
+                    }
+                }
+                for c in &far_closest {
+                    off[face_of_patch[c.patch.0 as usize] as usize] += 1;
+                }
+                break (stats, unresolved, search, outside_box, unmatched, off);
             }
             let load = if params.inflation != 0.0 {
                 Some(inflation_force(
@@ -280,6 +329,8 @@ pub fn recover_shape(
             unresolved,
             search_voxels: search,
             outside_box,
+            boundary_points: far_from.len(),
+            unmatched,
         });
         // A finer level that follows the image worse than its parent on
         // every count (a thin structure can pull the finer surface's
@@ -323,7 +374,9 @@ pub fn recover_shape(
                 ),
             );
         }
-        let met = (offsets.p95 <= params.tolerance_voxels && unresolved < 0.01)
+        let met = (offsets.p95 <= params.tolerance_voxels
+            && unresolved < 0.01
+            && unmatched <= params.max_unmatched)
             .then(|| format!("tolerance met at level {level}"));
         // The gain counts once the surface has found its boundary.
         let gain = match levels.as_slice() {
@@ -355,8 +408,28 @@ pub fn recover_shape(
             );
         }
         let h = refiner.refine_uniform(1)?;
-        let p1 = h.stencil(0).apply(&mesh.positions)?;
-        coarser = Some(std::mem::replace(&mut mesh, h.mesh(1, p1)));
+        let next = match params.refinement {
+            Refinement::Uniform => {
+                let p1 = h.stencil(0).apply(&mesh.positions)?;
+                h.mesh(1, p1)
+            }
+            Refinement::Adaptive => {
+                // The worst first, within the growth allowed.
+                let mut rank: Vec<usize> = (0..off.len()).filter(|&f| off[f] > 0).collect();
+                rank.sort_by(|&a, &b| off[b].cmp(&off[a]).then(a.cmp(&b)));
+                if rank.is_empty() {
+                    break (
+                        false,
+                        format!(
+                            "no face of level {level} is off the boundary: finer levels would not follow it better"
+                        ),
+                    );
+                }
+                let cap = params.max_level_growth * mesh.num_vertices() as Real;
+                split_within(&mesh, &h, &rank, cap)?.1.mesh
+            }
+        };
+        coarser = Some(std::mem::replace(&mut mesh, next));
     };
     let returned_level = levels.len().saturating_sub(1 + usize::from(dropped));
     Ok(RecoverResult {
@@ -418,4 +491,48 @@ fn gauss_points(table: &PatchTable, order: usize) -> Vec<(usize, [Real; 2])> {
         }
     }
     at
+}
+
+/// The points of `from` outside the limit surface of `engine` (whose
+/// samples `xs`, with tangents `us`, `vs`, sit at `at`) and farther than
+/// `reach` from it, with their closest points: the two-sided forces'
+/// springs. A point within `reach` of a sample, or behind its nearest
+/// sample's tangent plane, is left out at once; the others are searched
+/// from their nearest sample's patch. Points inside are left out: there the surface bridges a
+/// groove that the image springs along its normals see (a sulcus, a gap
+/// between legs), and a coarse level cannot follow a deep one; outside, it
+/// has missed a part (a horn tip, a leg the cage lost).
+fn far_points(
+    engine: &ClosestPointEngine,
+    xs: &[Point3],
+    us: &[Point3],
+    vs: &[Point3],
+    at: &[(usize, [Real; 2])],
+    from: &[Point3],
+    reach: Real,
+) -> Result<(Vec<Point3>, Vec<ClosestPoint>)> {
+    if from.is_empty() || xs.is_empty() {
+        return Ok((Vec::new(), Vec::new()));
+    }
+    let tree = ImmutableKdTree::<Real, 3>::new_from_slice(
+        &xs.iter().map(|x| [x.x, x.y, x.z]).collect::<Vec<_>>(),
+    );
+    let (candidates, starts): (Vec<Point3>, Vec<(u32, [Real; 2])>) = from
+        .par_iter()
+        .filter_map(|b| {
+            let nn = tree.nearest_one::<SquaredEuclidean>(&[b.x, b.y, b.z]);
+            let i = nn.item as usize;
+            let outward = (b - xs[i]).dot(&us[i].coords.cross(&vs[i].coords)) > 0.0;
+            (nn.distance > reach * reach && outward).then(|| {
+                let (f, st) = at[i];
+                (*b, (f as u32, st))
+            })
+        })
+        .unzip();
+    let closest = engine.closest_points_near(&candidates, &starts)?;
+    Ok(candidates
+        .into_iter()
+        .zip(closest)
+        .filter(|(b, c)| c.distance > reach && (b - c.point).dot(&c.normal) > 0.0)
+        .unzip())
 }

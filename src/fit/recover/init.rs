@@ -56,6 +56,12 @@ pub struct ComponentCage {
     pub simplified_from: Option<usize>,
     /// Genus of the cage.
     pub genus: i64,
+    /// Points on the component's iso-surface: on every voxel edge from a
+    /// voxel of the component to one outside the object, where the linear
+    /// interpolant crosses the level (the vertices marching cubes would
+    /// place; world coordinates, in voxel order). The recovery's two-sided
+    /// forces pull the surface towards those it leaves far.
+    pub boundary: Vec<Point3>,
 }
 
 /// The cage of one connected component of `{v : v > level}` (`< level` for
@@ -164,6 +170,7 @@ pub fn component_cage(
             sizes[chosen]
         )));
     }
+    let boundary = iso_crossings(volume, &label, chosen as u32, level);
     let (lo, hi) = boxes[chosen];
     let extent = (0..3).map(|a| hi[a] - lo[a] + 1).max().unwrap_or(1);
     let block = extent.div_ceil(resolution.max(2)).max(1);
@@ -242,7 +249,44 @@ pub fn component_cage(
         lost_voxels: lost,
         simplified_from,
         genus: topo.genus,
+        boundary,
     })
+}
+
+/// The points where the linear interpolant of `volume` crosses `level` on
+/// the edges from a voxel labelled `chosen` to a face neighbour with another
+/// label that is not inside (any neighbour outside the component is outside
+/// the object: components are maximal), in voxel order.
+fn iso_crossings(volume: &Volume, label: &[u32], chosen: u32, level: Real) -> Vec<Point3> {
+    let dims = volume.dims();
+    let data = volume.data();
+    let mut out = Vec::new();
+    for i in (0..label.len()).filter(|&i| label[i] == chosen) {
+        let c = [
+            i % dims[0],
+            (i / dims[0]) % dims[1],
+            i / (dims[0] * dims[1]),
+        ];
+        let a = data[i] as Real;
+        for d in FACE_NEIGHBOURS {
+            let w = [0, 1, 2].map(|k| c[k] as isize + d[k]);
+            if (0..3).any(|k| w[k] < 0 || w[k] >= dims[k] as isize) {
+                continue;
+            }
+            let j = volume.index(w[0] as usize, w[1] as usize, w[2] as usize);
+            if label[j] == chosen {
+                continue;
+            }
+            let b = data[j] as Real;
+            let t = if a == b {
+                0.5
+            } else {
+                ((a - level) / (a - b)).clamp(0.0, 1.0)
+            };
+            out.push(volume.world([0, 1, 2].map(|k| c[k] as Real + t * d[k] as Real)));
+        }
+    }
+    out
 }
 
 /// A component whose blocks lose more than this share of its voxels gets

@@ -1,6 +1,7 @@
 //! Parameters of [`recover_shape`](super::recover_shape).
 
 use crate::error::{Error, Result};
+use crate::fit::Refinement;
 use crate::forces::BoundaryModel;
 use crate::math::Real;
 
@@ -88,6 +89,34 @@ pub struct RecoverParams {
     /// not find it either), and [`poor_result`](super::poor_result) calls
     /// the result poor.
     pub max_unresolved: Real,
+    /// Total stiffness of the two-sided forces relative to the image
+    /// springs (default 2; 0 turns them off): the object's iso-surface
+    /// points ([`ComponentCage::boundary`](super::ComponentCage::boundary))
+    /// outside the limit surface and farther than
+    /// [`two_sided_voxels`](Self::two_sided_voxels) from it each pull their
+    /// closest point with a spring of `two_sided_weight / N` (`N` the
+    /// points used), as the scan fit's data springs do, so a part the
+    /// surface misses (a horn tip, a leg the cage lost) pulls it out at any
+    /// level.
+    pub two_sided_weight: Real,
+    /// How far outside the limit surface an iso-surface point must lie to
+    /// pull it, in voxels (default 0.5, the default tolerance).
+    pub two_sided_voxels: Real,
+    /// Largest share of the iso-surface points that pull (see
+    /// [`two_sided_weight`](Self::two_sided_weight)) for the tolerance to
+    /// count as met (default 0.05: the 95th percentile both ways).
+    pub max_unmatched: Real,
+    /// How a level above the tolerance is refined (default
+    /// [`Refinement::Adaptive`]: the faces nearest a pulling iso-surface
+    /// point, and while the 95th percentile of the offsets is above the
+    /// tolerance the faces with a sample off by more than it, are split,
+    /// the worst first, the others kept).
+    pub refinement: Refinement,
+    /// An adaptive level has at most this many times its parent's control
+    /// points (default 1.25): the faces farthest off are split first
+    /// (folded surfaces such as a brain's have far points everywhere, and
+    /// splitting all their faces costs the memory of a uniform level).
+    pub max_level_growth: Real,
 }
 
 impl Default for RecoverParams {
@@ -111,6 +140,11 @@ impl Default for RecoverParams {
             quadrature_order: 3,
             points_weight: 1.0,
             max_unresolved: 0.1,
+            two_sided_weight: 2.0,
+            two_sided_voxels: 0.5,
+            max_unmatched: 0.05,
+            refinement: Refinement::Adaptive,
+            max_level_growth: 1.25,
         }
     }
 }
@@ -174,6 +208,20 @@ impl RecoverParams {
         non_negative("bending", self.bending)?;
         positive("damping", self.damping)?;
         non_negative("points weight", self.points_weight)?;
+        non_negative("two-sided weight", self.two_sided_weight)?;
+        positive("two-sided distance", self.two_sided_voxels)?;
+        if !(self.max_level_growth.is_finite() && self.max_level_growth > 1.0) {
+            return Err(Error::Input(format!(
+                "max level growth {} must be a number above 1",
+                self.max_level_growth
+            )));
+        }
+        if !(0.0..=1.0).contains(&self.max_unmatched) {
+            return Err(Error::Input(format!(
+                "max unmatched {} must be a fraction in [0, 1]",
+                self.max_unmatched
+            )));
+        }
         if !(0.0..=1.0).contains(&self.max_unresolved) {
             return Err(Error::Input(format!(
                 "max unresolved {} must be a fraction in [0, 1]",

@@ -31,6 +31,11 @@ pub struct RecoverLevel {
     pub unresolved: Real,
     /// Search half-length used, in voxels.
     pub search_voxels: Real,
+    /// Iso-surface points the two-sided forces used (0: none).
+    pub boundary_points: usize,
+    /// Share of them farther than the two-sided distance from the limit
+    /// surface at the level's end.
+    pub unmatched: Real,
     /// Fraction of samples more than 1 voxel outside the volume's sample
     /// box (the padded box, so a surface closed on the box faces is inside).
     pub outside_box: Real,

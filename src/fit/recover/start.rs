@@ -34,14 +34,27 @@ pub enum RecoverStart {
     Mesh(PolyMesh),
 }
 
-/// The initial control mesh for `start` in `prepared`, and the `init` object
-/// of `subdyn recover --report` (`method`: `seed`, `auto` or `mesh`, with
-/// the counts). `bright_inside` is false for dark objects.
+/// What a recovery starts from ([`initial_model`]).
+#[derive(Clone, Debug)]
+pub struct InitialModel {
+    /// The initial control mesh.
+    pub mesh: PolyMesh,
+    /// The object's iso-surface points for the two-sided forces
+    /// ([`ComponentCage::boundary`](super::ComponentCage::boundary)) when
+    /// the object is known (an automatic cage); empty otherwise.
+    pub boundary: Vec<Point3>,
+    /// The `init` object of `subdyn recover --report` (`method`: `seed`,
+    /// `auto` or `mesh`, with the counts).
+    pub report: Value,
+}
+
+/// The initial model for `start` in `prepared`. `bright_inside` is false
+/// for dark objects.
 pub fn initial_model(
     prepared: &PreparedVolume,
     start: &RecoverStart,
     bright_inside: bool,
-) -> Result<(PolyMesh, Value)> {
+) -> Result<InitialModel> {
     let volume = &prepared.smoothed;
     match start {
         RecoverStart::Seed {
@@ -84,12 +97,20 @@ pub fn initial_model(
             let value = json!({"method": "seed", "seed": [p.x, p.y, p.z],
                 "radius_voxels": radius_voxels,
                 "vertices": mesh.num_vertices(), "faces": mesh.num_faces()});
-            Ok((mesh, value))
+            Ok(InitialModel {
+                mesh,
+                boundary: Vec::new(),
+                report: value,
+            })
         }
         RecoverStart::Mesh(mesh) => {
             let value = json!({"method": "mesh",
                 "vertices": mesh.num_vertices(), "faces": mesh.num_faces()});
-            Ok((mesh.clone(), value))
+            Ok(InitialModel {
+                mesh: mesh.clone(),
+                boundary: Vec::new(),
+                report: value,
+            })
         }
         RecoverStart::Auto { seed, resolution } => {
             if !(2..=128).contains(resolution) {
@@ -107,9 +128,13 @@ pub fn initial_model(
             let value = json!({"method": "auto", "component_voxels": cage.voxels,
                 "components": cage.components, "block_voxels": cage.block,
                 "lost_voxels": cage.lost_voxels, "simplified_from_block": cage.simplified_from,
-                "genus": cage.genus,
+                "genus": cage.genus, "boundary_points": cage.boundary.len(),
                 "vertices": cage.mesh.num_vertices(), "faces": cage.mesh.num_faces()});
-            Ok((cage.mesh, value))
+            Ok(InitialModel {
+                mesh: cage.mesh,
+                boundary: cage.boundary,
+                report: value,
+            })
         }
     }
 }
