@@ -120,16 +120,17 @@ fn slice_pictures_show_the_contour_where_the_surface_cuts_the_plane() {
     }
     let yellow = [255, 220, 0];
     // z index 10 is world z 20, inside the cube's z range [15, 25].
-    let pic = slice_overlay(&v, 2, 10, 200, &[(&cube, yellow)]).unwrap();
+    let z = |k: Real| v.world([0.0, 0.0, k]).z;
+    let pic = slice_overlay(&v, 2, z(10.0), 200, &[(&cube, yellow)], "mm").unwrap();
     assert_eq!((pic.width(), pic.height()), (200, 200));
     let drawn = pic.count(|c| c == yellow);
     // The square contour's side is 10 voxels = 100 pixels: about 4 × 100 × 2 pixels.
     assert!(drawn > 600 && drawn < 1200, "{drawn} contour pixels");
     // z index 2 (world 12) misses the cube: no contour, only the label.
-    let none = slice_overlay(&v, 2, 2, 200, &[(&cube, yellow)]).unwrap();
+    let none = slice_overlay(&v, 2, z(2.0), 200, &[(&cube, yellow)], "").unwrap();
     assert_eq!(none.count(|c| c == yellow), 0);
-    assert!(slice_overlay(&v, 3, 0, 200, &[]).is_err());
-    assert!(slice_overlay(&v, 2, 20, 200, &[]).is_err());
+    assert!(slice_overlay(&v, 3, z(0.0), 200, &[], "").is_err());
+    assert!(slice_overlay(&v, 2, z(20.0), 200, &[], "").is_err());
 }
 
 /// The in-place passes equal a direct separable convolution (f64, borders

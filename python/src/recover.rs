@@ -13,6 +13,7 @@ use subdyn::fit::recover::{
     poor_result,
     prepare_volume_owned, recover_shape,
 };
+use subdyn::fit::Refinement;
 use subdyn::forces::BoundaryModel;
 use subdyn::math::Point3;
 use subdyn::volume::Volume;
@@ -38,6 +39,9 @@ const RECOVER_OPTIONS: &[&str] = &[
     "points_weight",
     "two_sided_weight",
     "two_sided_distance",
+    "max_unmatched",
+    "refine",
+    "max_level_growth",
     "bending",
     "tess",
     "quads",
@@ -85,6 +89,15 @@ pub fn recover<'py>(
         points_weight: o.f64("points_weight", d.points_weight)?,
         two_sided_weight: o.f64("two_sided_weight", d.two_sided_weight)?,
         two_sided_voxels: o.f64("two_sided_distance", d.two_sided_voxels)?,
+        max_unmatched: o.f64("max_unmatched", d.max_unmatched)?,
+        refinement: match o
+            .choice("refine", "adaptive", &["adaptive", "uniform"])?
+            .as_str()
+        {
+            "uniform" => Refinement::Uniform,
+            _ => Refinement::Adaptive,
+        },
+        max_level_growth: o.f64("max_level_growth", d.max_level_growth)?,
         ..d
     };
     params.check().map_err(crate::arrays::py_err)?;

@@ -171,7 +171,8 @@ def recover(volume: Any, spacing: Sequence[float] = (1.0, 1.0, 1.0),
     CT in Hounsfield units), ``edge_strength``, ``dark``, ``sigma``, ``tol`` (voxels), ``max_level``,
     ``auto``, ``seed`` ((x, y, z)), ``seed_radius``, ``resolution``,
     ``points_weight``, ``two_sided_weight``, ``two_sided_distance``
-    (voxels), ``bending``, ``tess``, ``quads``, ``threads``, ``accept_poor``, ``open_at_box`` (an object cut by the volume's box is
+    (voxels), ``max_unmatched``, ``refine`` ("adaptive" or "uniform"),
+    ``max_level_growth``, ``bending``, ``tess``, ``quads``, ``threads``, ``accept_poor``, ``open_at_box`` (an object cut by the volume's box is
     left open there, its rim on the box face; by default it closes on the
     face). A poor result (the surface leaves the volume's box, much
     of it found no boundary, or a level got worse) raises ``ValueError``

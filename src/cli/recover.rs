@@ -6,8 +6,11 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args;
+
+use super::fit::RefineMode;
 use serde_json::json;
 
+use subdyn::fit::Refinement;
 use subdyn::fit::recover::{
     BONE_HU, PreparedVolume, RecoverParams, RecoverReport, RecoverStart, SKIN_HU, opened_at_box,
     poor_result, prepare_volume_owned, recover_shape,
@@ -108,6 +111,13 @@ pub struct RecoverArgs {
     /// from the surface for the tolerance to count as met.
     #[arg(long, value_name = "F", default_value_t = RecoverParams::default().max_unmatched)]
     pub max_unmatched: f64,
+    /// How a level above the tolerance is refined: the faces off the
+    /// boundary (adaptive) or every face (uniform).
+    #[arg(long, value_enum, default_value_t = RefineMode::Adaptive)]
+    pub refine: RefineMode,
+    /// An adaptive level has at most this many times its parent's control points.
+    #[arg(long, value_name = "F", default_value_t = RecoverParams::default().max_level_growth)]
+    pub max_level_growth: f64,
     /// Bending weight λ_b of the thin plate.
     #[arg(long, value_name = "λ", default_value_t = RecoverParams::default().bending)]
     pub bending: f64,
@@ -123,7 +133,9 @@ pub struct RecoverArgs {
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
     /// Write slices with the recovered contour (yellow) and the initial one
-    /// (blue) over the image to this directory: three z slices, one y, one x.
+    /// (blue) over the image to this directory: three axial slices, one
+    /// coronal, one sagittal, in the radiological convention (right on the
+    /// left, anterior or superior up), labelled with their world position.
     #[arg(long, value_name = "DIR")]
     pub slices_png: Option<PathBuf>,
     /// Write the result even when it is poor: its surface leaves the
@@ -206,6 +218,11 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
         two_sided_weight: args.two_sided_weight,
         two_sided_voxels: args.two_sided_distance,
         max_unmatched: args.max_unmatched,
+        refinement: match args.refine {
+            RefineMode::Adaptive => Refinement::Adaptive,
+            RefineMode::Uniform => Refinement::Uniform,
+        },
+        max_level_growth: args.max_level_growth,
         ..Default::default()
     };
     params.check()?;
@@ -308,7 +325,7 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
         let image = read_volume(&args.input, &read_options)
             .map_err(|e| about_file(e, &args.input))?
             .volume;
-        slice_files = write_slices(dir, &image, &surf, &init_surf)?;
+        slice_files = write_slices(dir, &args.input, &image, &surf, &init_surf)?;
     }
     drop(progress);
     if let Some(path) = &args.report {
@@ -401,38 +418,34 @@ fn cli_wording(message: &str) -> Option<String> {
         })
 }
 
-/// Three z slices through the object (at a quarter, half and three
-/// quarters of its extent), and the middle y and x slices.
+/// Three axial slices through the object (at a quarter, half and three
+/// quarters of its world z extent), and the coronal and sagittal slices
+/// through its middle, in the radiological convention
+/// ([`slice_overlay`](subdyn::render::slice_overlay)); positions in mm for
+/// NIfTI input (RAS+ mm), in world units otherwise.
 fn write_slices(
     dir: &Path,
+    input: &Path,
     volume: &subdyn::volume::Volume,
     surface: &PolyMesh,
     initial: &PolyMesh,
 ) -> anyhow::Result<Vec<String>> {
     use subdyn::render::{slice_overlay, write_png};
     subdyn::io::create_output_dir(dir)?;
-    let idx: Vec<[Real; 3]> = surface
-        .positions
-        .iter()
-        .map(|p| volume.continuous_index(p))
-        .collect();
-    let dims = volume.dims();
-    let extent = |a: usize| {
-        let lo = idx
-            .iter()
-            .map(|c| c[a])
-            .fold(Real::INFINITY, Real::min)
-            .max(0.0);
-        let hi = idx
-            .iter()
-            .map(|c| c[a])
-            .fold(Real::NEG_INFINITY, Real::max)
-            .min((dims[a] - 1) as Real);
-        (lo, hi)
+    let name = input.to_string_lossy().to_ascii_lowercase();
+    let unit = if name.ends_with(".nii") || name.ends_with(".nii.gz") {
+        "mm"
+    } else {
+        ""
     };
     let at = |a: usize, f: Real| {
-        let (lo, hi) = extent(a);
-        ((lo + f * (hi - lo)).round().max(0.0) as usize).min(dims[a] - 1)
+        let (lo, hi) = surface
+            .positions
+            .iter()
+            .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p[a]), hi.max(p[a]))
+            });
+        lo + f * (hi - lo)
     };
     let views = [
         (2, at(2, 0.25)),
@@ -442,15 +455,21 @@ fn write_slices(
         (0, at(0, 0.5)),
     ];
     let mut files = Vec::new();
-    for (axis, index) in views {
+    for (axis, position) in views {
         let pic = slice_overlay(
             volume,
             axis,
-            index,
+            position,
             512,
             &[(initial, [60, 140, 255]), (surface, [255, 220, 0])],
+            unit,
         )?;
-        let path = dir.join(format!("slice_{}{index:04}.png", ["x", "y", "z"][axis]));
+        let path = dir.join(format!(
+            "{}_{}{:.1}.png",
+            ["sagittal", "coronal", "axial"][axis],
+            ["x", "y", "z"][axis],
+            (10.0 * position).round() / 10.0 + 0.0
+        ));
         write_png(&path, &pic).map_err(|e| about_file(e, &path))?;
         files.push(path.display().to_string());
     }

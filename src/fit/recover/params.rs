@@ -113,7 +113,7 @@ pub struct RecoverParams {
     /// the worst first, the others kept).
     pub refinement: Refinement,
     /// An adaptive level has at most this many times its parent's control
-    /// points (default 1.25): the faces farthest off are split first
+    /// points (default 2): the faces farthest off are split first
     /// (folded surfaces such as a brain's have far points everywhere, and
     /// splitting all their faces costs the memory of a uniform level).
     pub max_level_growth: Real,
@@ -144,7 +144,7 @@ impl Default for RecoverParams {
             two_sided_voxels: 0.5,
             max_unmatched: 0.05,
             refinement: Refinement::Adaptive,
-            max_level_growth: 1.25,
+            max_level_growth: 2.0,
         }
     }
 }
