@@ -5,10 +5,10 @@ mod common;
 
 use common::sdf::{sdf_volume, surface_error, write_raw};
 
+use subdyn::fit::Refinement;
 use subdyn::fit::recover::{
     RecoverParams, component_cage, prepare_volume, prepare_volume_owned, recover_shape, seed_cage,
 };
-use subdyn::fit::Refinement;
 use subdyn::forces::BoundaryModel;
 use subdyn::limit::tessellate;
 use subdyn::math::{Point3, Real};
