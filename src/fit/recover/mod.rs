@@ -18,4 +18,4 @@ pub use params::{BONE_HU, RecoverParams, SKIN_HU};
 pub use prepare::{PreparedVolume, prepare_volume, prepare_volume_owned};
 pub use quality::poor_result;
 pub use report::{RecoverLevel, RecoverReport};
-pub use start::{InitialModel, RecoverStart, initial_model};
+pub use start::{CAGE_SIGMA_VOXELS, InitialModel, RecoverStart, initial_model};

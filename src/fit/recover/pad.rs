@@ -104,14 +104,38 @@ pub fn opened_at_box(control: &PolyMesh, padded: &Volume) -> Result<PolyMesh> {
         let n = newell_normal(&control.positions, f);
         n.dot(&outward(axis, high)) >= FRAC_1_SQRT_2 * n.norm()
     };
+    let mut cap: Vec<Option<(usize, bool)>> = control
+        .faces()
+        .map(|f| {
+            (0..3)
+                .flat_map(|axis| [(axis, false), (axis, true)])
+                .find(|&(axis, high)| {
+                    f.iter().all(|&v| on(v, axis, high)) && faces_out(f, axis, high)
+                })
+        })
+        .collect();
+    // Islands of kept faces inside the opening (a face the noise tilted
+    // away from the box face) go with the cap: only the largest part of the
+    // surface is kept.
+    let part = edge_components(control, &cap);
+    let mut sizes = vec![0usize; part.iter().flatten().max().map_or(0, |&m| m + 1)];
+    for &p in part.iter().flatten() {
+        sizes[p] += 1;
+    }
+    let largest = (0..sizes.len()).max_by_key(|&p| (sizes[p], std::cmp::Reverse(p)));
+    for (f, face) in control.faces().enumerate() {
+        if part[f].is_some() && part[f] != largest {
+            cap[f] = (0..3)
+                .flat_map(|axis| [(axis, false), (axis, true)])
+                .find(|&(axis, high)| face.iter().all(|&v| on(v, axis, high)));
+        }
+    }
+    keep_manifold(control, &mut cap);
     let mut keep = Vec::new();
     // Per vertex and axis, the index of the box face of a removed face.
     let mut face_of = vec![[None::<Real>; 3]; control.num_vertices()];
-    for f in control.faces() {
-        let capped = (0..3)
-            .flat_map(|axis| [(axis, false), (axis, true)])
-            .find(|&(axis, high)| f.iter().all(|&v| on(v, axis, high)) && faces_out(f, axis, high));
-        match capped {
+    for (f, c) in control.faces().zip(&cap) {
+        match *c {
             Some((axis, high)) => {
                 let at = if high { dims[axis] as Real - 1.5 } else { 0.5 };
                 for &v in f {
@@ -152,4 +176,105 @@ pub fn opened_at_box(control: &PolyMesh, padded: &Volume) -> Result<PolyMesh> {
         }
     }
     PolyMesh::from_faces(positions, &keep)
+}
+
+/// Puts back (sets to `None`) cap faces of `cap` until no vertex's kept
+/// faces form more than one fan: removing the caps can leave a vertex
+/// where two parts of the surface meet at a point only (a bow tie), which
+/// is not a manifold; all faces round such a vertex are kept.
+fn keep_manifold(control: &PolyMesh, cap: &mut [Option<(usize, bool)>]) {
+    let mut around: Vec<Vec<u32>> = vec![Vec::new(); control.num_vertices()];
+    for (f, face) in control.faces().enumerate() {
+        for &v in face {
+            around[v as usize].push(f as u32);
+        }
+    }
+    // The neighbours of `v` along face `f`'s sides (the previous and the
+    // next corner).
+    let sides = |f: u32, v: u32| {
+        let face = control.face(f as usize);
+        let i = face.iter().position(|&u| u == v).unwrap_or(0);
+        let n = face.len();
+        [face[(i + n - 1) % n], face[(i + 1) % n]]
+    };
+    loop {
+        let mut changed = false;
+        for (v, faces) in around.iter().enumerate() {
+            let kept: Vec<u32> = faces
+                .iter()
+                .copied()
+                .filter(|&f| cap[f as usize].is_none())
+                .collect();
+            if kept.len() < 2 || kept.len() == faces.len() {
+                continue;
+            }
+            // Fans: kept faces joined through a shared side at `v`.
+            let mut fan: Vec<usize> = (0..kept.len()).collect();
+            let root = |fan: &mut Vec<usize>, mut i: usize| {
+                while fan[i] != i {
+                    fan[i] = fan[fan[i]];
+                    i = fan[i];
+                }
+                i
+            };
+            for a in 0..kept.len() {
+                for b in a + 1..kept.len() {
+                    let (sa, sb) = (sides(kept[a], v as u32), sides(kept[b], v as u32));
+                    if sa.iter().any(|w| sb.contains(w)) {
+                        let (ra, rb) = (root(&mut fan, a), root(&mut fan, b));
+                        fan[ra] = rb;
+                    }
+                }
+            }
+            let fans = (0..kept.len()).filter(|&i| root(&mut fan, i) == i).count();
+            if fans > 1 {
+                for &f in faces {
+                    cap[f as usize] = None;
+                }
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+}
+
+/// The connected parts (through shared edges) of the faces of `control`
+/// that `cap` keeps (`None` for a cap face), numbered from 0 in face order.
+fn edge_components(control: &PolyMesh, cap: &[Option<(usize, bool)>]) -> Vec<Option<usize>> {
+    let mut by_edge: std::collections::HashMap<(u32, u32), Vec<usize>> =
+        std::collections::HashMap::new();
+    for (f, face) in control.faces().enumerate() {
+        if cap[f].is_some() {
+            continue;
+        }
+        for i in 0..face.len() {
+            let (a, b) = (face[i], face[(i + 1) % face.len()]);
+            by_edge.entry((a.min(b), a.max(b))).or_default().push(f);
+        }
+    }
+    let mut part: Vec<Option<usize>> = vec![None; control.num_faces()];
+    let mut next = 0;
+    for start in 0..control.num_faces() {
+        if cap[start].is_some() || part[start].is_some() {
+            continue;
+        }
+        part[start] = Some(next);
+        let mut stack = vec![start];
+        while let Some(f) = stack.pop() {
+            let face = control.face(f);
+            for i in 0..face.len() {
+                let (a, b) = (face[i], face[(i + 1) % face.len()]);
+                for &g in &by_edge[&(a.min(b), a.max(b))] {
+                    if part[g].is_none() {
+                        part[g] = Some(next);
+                        stack.push(g);
+                    }
+                }
+            }
+        }
+        next += 1;
+    }
+    part
 }

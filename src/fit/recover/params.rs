@@ -36,8 +36,11 @@ pub struct RecoverParams {
     pub boundary: BoundaryModel,
     /// Gaussian smoothing σ in world units (default `None`: half a voxel
     /// for an iso-surface, one voxel for edges). Blur moves a curved
-    /// iso-surface inward by about `σ² κ / 2` (κ the mean curvature), so an
-    /// iso-surface gets only enough to tame voxel noise; edges need more.
+    /// iso-surface inward by about `σ² κ / 2` (κ the mean curvature) and
+    /// rounds edges and tips, so an iso-surface gets only enough to tame
+    /// voxel noise; edges need more. The automatic cage is taken from the
+    /// volume smoothed to at least half a voxel
+    /// ([`CAGE_SIGMA_VOXELS`](super::CAGE_SIGMA_VOXELS)).
     pub sigma: Option<Real>,
     /// The object is brighter than its surroundings (default true).
     pub bright_inside: bool,
