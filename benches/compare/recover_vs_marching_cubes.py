@@ -75,7 +75,8 @@ One command (from anywhere; needs target/release/subdyn and target/release/data-
 Options: --repeat N (timed runs per method, median reported; default 3),
 --keep DIR (keep volumes, meshes and compare reports there instead of a
 temporary directory), --subdyn / --data-gen (binaries), --out DIR,
---no-mni (skip step 7).
+--no-mni (skip step 7), --sigma-voxels F (subdyn recover with `--sigma` of F voxels
+instead of its default, for experiments).
 
 A comparison beside the product, never a dependency of it; not part of CI.
 Standard library only outside the venv.
@@ -432,6 +433,12 @@ def marching_cubes(side: dict, base: Path, out: Path, smooth: bool) -> dict:
     }
 
 
+def sigma_args(args, voxel: float) -> list:
+    """`--sigma` for subdyn recover when --sigma-voxels is given (σ in voxels × the smallest
+    spacing), else nothing (subdyn's default)."""
+    return [] if args.sigma_voxels is None else ["--sigma", repr(args.sigma_voxels * voxel)]
+
+
 def subdyn_recover(subdyn: Path, base: Path, iso: float, work: Path, extra=()) -> dict:
     """One `subdyn recover` process (under measure_process). A failed run gives failed=True, its
     exit code and stderr line, and no files (stale ones are removed first)."""
@@ -688,7 +695,8 @@ def mni_section(args, work: Path) -> dict:
         sd_runs, mc_runs = [], []
         for i in range(args.repeat):  # interleaved: subdyn, marching cubes, subdyn, ...
             log(f"MNI {key}: subdyn recover (run {i + 1})")
-            sd = subdyn_recover(args.subdyn, MNI_T1, c_iso, wd, extra)
+            sd = subdyn_recover(args.subdyn, MNI_T1, c_iso, wd,
+                                extra + sigma_args(args, float(spacing.min())))
             sd.pop("fit"), sd.pop("surf")
             sd_runs.append(sd)
             log(f"MNI {key}: Gaussian smoothing + marching cubes (run {i + 1})")
@@ -724,7 +732,7 @@ def mni_section(args, work: Path) -> dict:
         wd = work / "mni-gm"
         wd.mkdir(exist_ok=True)
         log("MNI grey-matter map: subdyn recover --iso 128")
-        gm = subdyn_recover(args.subdyn, MNI_GM, 128.0, wd)
+        gm = subdyn_recover(args.subdyn, MNI_GM, 128.0, wd, sigma_args(args, float(spacing.min())))
         gm.pop("fit"), gm.pop("surf")
         gm["peak_rss_ratio"] = gm["peak_rss_bytes"] / (4 * voxels) if gm["peak_rss_bytes"] else None
         out["gm"] = gm
@@ -840,7 +848,8 @@ def one_volume(args, spec: dict, work: Path) -> dict:
         rows.append(measured(label, out, dict(kind=tag, topology=mesh_info(args.subdyn, out), **mc), tag=tag))
 
     log(f"{name}: subdyn recover")
-    runs = [subdyn_recover(args.subdyn, base, iso, work) for _ in range(args.repeat)]
+    runs = [subdyn_recover(args.subdyn, base, iso, work, sigma_args(args, min(side["spacing"])))
+            for _ in range(args.repeat)]
     sd = runs[-1]  # its files are the ones on disk
     sd["seconds_all"] = [r["seconds"] for r in runs]
     sd["seconds"] = statistics.median(sd["seconds_all"])
@@ -1103,6 +1112,8 @@ def main() -> None:
     ap.add_argument("--keep", type=Path, default=None, help="keep volumes and outputs in this directory")
     ap.add_argument("--repeat", type=int, default=3, help="timed runs per method (median reported)")
     ap.add_argument("--no-mni", action="store_true", help="skip the MNI templates")
+    ap.add_argument("--sigma-voxels", type=float, default=None,
+                    help="pass --sigma (this many voxels of the smallest spacing) to every subdyn recover")
     ap.add_argument("--upgrade", action="store_true", help="reinstall the venv packages")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
