@@ -59,7 +59,7 @@ One command (from anywhere; needs target/release/subdyn and target/release/data-
    docs give no whole-brain command; ISO = half the median intensity of the
    voxels 3-5 voxels inside the skull-stripped brain's edge, computed here
    with numpy/scipy, the background being 0) against a fresh Python process
-   that reads the NIfTI, smooths by subdyn's σ (half a voxel, f32) with
+   that reads the NIfTI, smooths by half a voxel (f32; subdyn's cage smoothing, its forces use a quarter) with
    scipy.ndimage.gaussian_filter and runs marching cubes at the same iso,
    interleaved, --repeat times each; both under /usr/bin/time -v: wall time,
    peak RSS ÷ (voxels × 4 bytes), the ratio subdyn ÷ (smoothing + marching
@@ -679,7 +679,7 @@ def mni_section(args, work: Path) -> dict:
     out["brain_iso"] = bi
     del vol
     iso = round(bi["iso"], 3)
-    sigma = 0.5 * float(spacing.min())  # subdyn recover's default with --iso: half a voxel
+    sigma = 0.5 * float(spacing.min())  # subdyn recover's cage smoothing with --iso (its forces: a quarter voxel)
     base = [VENV_PY, "-c", "import numpy, scipy.ndimage, skimage.measure"]
     out["python_import_baseline"] = {k: v for k, v in measure_process(
         base, work / "mni-python-baseline.time").items() if k != "stderr"}
@@ -1059,7 +1059,7 @@ def mni_tables(mni, md) -> None:
               f"whole-brain command (only the ventricle one), so the brain uses `--iso {round(bi['iso'], 3)}`: "
               f"{bi['how']} ({100 * bi.get('zero_fraction', 0):.1f} % of the voxels are 0, the non-zero voxels form "
               f"{bi.get('nonzero_components')} component(s); tissue median {bi.get('tissue_median')}). "
-              f"Smoothing for marching cubes: σ = {mni['cases'][0]['sigma_world']} mm, subdyn's default with --iso; "
+              f"Smoothing for marching cubes: σ = {mni['cases'][0]['sigma_world']} mm, subdyn's cage smoothing with --iso (its forces: a quarter voxel); "
               f"float32. Interleaved runs, each a fresh process under "
               f"{mni['cases'][0]['subdyn']['peak_rss_method']}.")
     md.append("")

@@ -69,7 +69,7 @@ pub struct RecoverArgs {
     /// The object is darker than its surroundings (ventricles in T1 MRI, air).
     #[arg(long)]
     pub dark: bool,
-    /// Gaussian smoothing σ in world units (default: half a voxel with --iso, one voxel for edges; the --auto cage is taken at half a voxel or more).
+    /// Gaussian smoothing σ in world units (default: a quarter of a voxel with --iso, one voxel for edges; the --auto cage is taken at half a voxel or more).
     #[arg(long, value_name = "S")]
     pub sigma: Option<f64>,
     /// Voxel spacing for formats without it (world = origin + index × spacing).

@@ -114,14 +114,24 @@ pub fn opened_at_box(control: &PolyMesh, padded: &Volume) -> Result<PolyMesh> {
                 })
         })
         .collect();
+    // Stray cap faces (a bump that tilts a wall face near the rim towards
+    // the box face) stay: only connected groups of cap faces of at least a
+    // tenth of the largest group's size are removed.
+    let capped: Vec<bool> = cap.iter().map(Option::is_some).collect();
+    let groups = edge_components(control, &capped);
+    let group_sizes = part_sizes(&groups);
+    let big = group_sizes.iter().copied().max().unwrap_or(0);
+    for (c, g) in cap.iter_mut().zip(&groups) {
+        if g.is_some_and(|g| 10 * group_sizes[g] < big) {
+            *c = None;
+        }
+    }
     // Islands of kept faces inside the opening (a face the noise tilted
     // away from the box face) go with the cap: only the largest part of the
     // surface is kept.
-    let part = edge_components(control, &cap);
-    let mut sizes = vec![0usize; part.iter().flatten().max().map_or(0, |&m| m + 1)];
-    for &p in part.iter().flatten() {
-        sizes[p] += 1;
-    }
+    let kept: Vec<bool> = cap.iter().map(Option::is_none).collect();
+    let part = edge_components(control, &kept);
+    let sizes = part_sizes(&part);
     let largest = (0..sizes.len()).max_by_key(|&p| (sizes[p], std::cmp::Reverse(p)));
     for (f, face) in control.faces().enumerate() {
         if part[f].is_some() && part[f] != largest {
@@ -240,13 +250,23 @@ fn keep_manifold(control: &PolyMesh, cap: &mut [Option<(usize, bool)>]) {
     }
 }
 
+/// How many faces each part of [`edge_components`] has.
+fn part_sizes(part: &[Option<usize>]) -> Vec<usize> {
+    let mut sizes = vec![0usize; part.iter().flatten().max().map_or(0, |&m| m + 1)];
+    for &p in part.iter().flatten() {
+        sizes[p] += 1;
+    }
+    sizes
+}
+
 /// The connected parts (through shared edges) of the faces of `control`
-/// that `cap` keeps (`None` for a cap face), numbered from 0 in face order.
-fn edge_components(control: &PolyMesh, cap: &[Option<(usize, bool)>]) -> Vec<Option<usize>> {
+/// that are `member`s, numbered from 0 in face order (`None` for the
+/// others).
+fn edge_components(control: &PolyMesh, member: &[bool]) -> Vec<Option<usize>> {
     let mut by_edge: std::collections::HashMap<(u32, u32), Vec<usize>> =
         std::collections::HashMap::new();
     for (f, face) in control.faces().enumerate() {
-        if cap[f].is_some() {
+        if !member[f] {
             continue;
         }
         for i in 0..face.len() {
@@ -257,7 +277,7 @@ fn edge_components(control: &PolyMesh, cap: &[Option<(usize, bool)>]) -> Vec<Opt
     let mut part: Vec<Option<usize>> = vec![None; control.num_faces()];
     let mut next = 0;
     for start in 0..control.num_faces() {
-        if cap[start].is_some() || part[start].is_some() {
+        if !member[start] || part[start].is_some() {
             continue;
         }
         part[start] = Some(next);

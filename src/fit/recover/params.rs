@@ -34,8 +34,8 @@ pub struct RecoverParams {
     /// What marks the boundary (default: the edge potential with
     /// `min_strength` 0.1; use [`BoundaryModel::Iso`] when the iso-value is known).
     pub boundary: BoundaryModel,
-    /// Gaussian smoothing σ in world units (default `None`: half a voxel
-    /// for an iso-surface, one voxel for edges). Blur moves a curved
+    /// Gaussian smoothing σ in world units (default `None`: a quarter of a
+    /// voxel for an iso-surface, one voxel for edges). Blur moves a curved
     /// iso-surface inward by about `σ² κ / 2` (κ the mean curvature) and
     /// rounds edges and tips, so an iso-surface gets only enough to tame
     /// voxel noise; edges need more. The automatic cage is taken from the

@@ -89,7 +89,7 @@ fn checked_sigma(volume: &Volume, params: &RecoverParams) -> Result<Real> {
     }
     Ok(params.sigma.unwrap_or(
         match params.boundary {
-            BoundaryModel::Iso { .. } => 0.5,
+            BoundaryModel::Iso { .. } => 0.25,
             BoundaryModel::Edge { .. } => 1.0,
         } * volume.voxel_size(),
     ))
