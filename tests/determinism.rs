@@ -8,8 +8,7 @@ mod common;
 
 use std::path::Path;
 
-use common::sdf::{sdf_volume, write_raw};
-use subdyn::math::Point3;
+use common::sdf::{noisy_ball_with_rod, sdf_volume, write_raw};
 
 /// A noisy torus scan (radii 1 and 0.4) as XYZ: 6,000 points, with
 /// deterministic pseudo-random offsets along the normal.
@@ -109,17 +108,12 @@ fn fit_and_subdivide_give_the_same_bytes_on_1_2_and_3_threads() {
 /// the same control mesh and limit surface on 1, 2 and 3 threads.
 #[test]
 fn recover_gives_the_same_bytes_on_1_2_and_3_threads() {
-    let c = Point3::new(16.0, 20.0, 24.0);
-    let (from, tip) = (Point3::new(22.0, 20.0, 20.0), Point3::new(36.0, 20.0, 20.0));
-    let sdf = move |p: Point3| {
-        let t = ((p - from).dot(&(tip - from)) / (tip - from).norm_squared()).clamp(0.0, 1.0);
-        let rod = (p - (from + t * (tip - from))).norm() - 1.0;
-        let noise =
-            0.05 * ((p.x * 12.9898 + p.y * 78.233 + p.z * 37.719).sin() * 43_758.545).fract();
-        ((p - c).norm() - 9.0).min(rod) + noise
-    };
     let dir = tempfile::tempdir().unwrap();
-    let path = write_raw(dir.path(), "v", &sdf_volume([42, 40, 32], [1.0; 3], sdf));
+    let path = write_raw(
+        dir.path(),
+        "v",
+        &sdf_volume([42, 40, 32], [1.0; 3], noisy_ball_with_rod),
+    );
     let mut outputs = Vec::new();
     for threads in [1, 2, 3] {
         let (obj, ply, report) = (

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::sdf::{sdf_volume, surface_error, write_raw};
+use common::sdf::{noisy_ball_with_rod, sdf_volume, surface_error, write_raw};
 use subdyn::fit::ErrorStats;
 use subdyn::fit::recover::{
     RecoverLevel, RecoverParams, RecoverReport, component_cage, poor_result, prepare_volume,
@@ -125,17 +125,12 @@ fn open_at_box_leaves_the_cut_open_with_its_rim_on_the_face() {
 /// piece with a boundary.
 #[test]
 fn open_at_box_leaves_a_manifold_when_noise_tilts_cap_faces() {
-    let c = Point3::new(16.0, 20.0, 24.0);
-    let (from, tip) = (Point3::new(22.0, 20.0, 20.0), Point3::new(36.0, 20.0, 20.0));
-    let sdf = move |p: Point3| {
-        let t = ((p - from).dot(&(tip - from)) / (tip - from).norm_squared()).clamp(0.0, 1.0);
-        let rod = (p - (from + t * (tip - from))).norm() - 1.0;
-        let noise =
-            0.05 * ((p.x * 12.9898 + p.y * 78.233 + p.z * 37.719).sin() * 43_758.545).fract();
-        ((p - c).norm() - 9.0).min(rod) + noise
-    };
     let dir = tempfile::tempdir().unwrap();
-    let path = write_raw(dir.path(), "v", &sdf_volume([42, 40, 32], [1.0; 3], sdf));
+    let path = write_raw(
+        dir.path(),
+        "v",
+        &sdf_volume([42, 40, 32], [1.0; 3], noisy_ball_with_rod),
+    );
     let out = common::run_subdyn(
         dir.path(),
         &[

@@ -24,7 +24,7 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use super::gauss_legendre;
-use super::quadrature::{invert, rows_to_base};
+use super::quadrature::{invert, rows_to_base, square_rule};
 use crate::error::{Error, Result};
 use crate::limit::{PatchTable, SampleStencil, patch_weights};
 use crate::math::Real;
@@ -479,10 +479,7 @@ fn irregular_element<const N: usize>(
     local: Option<&[u32]>,
 ) -> (Vec<u32>, Matrices<N>, bool) {
     let (inv, det) = frame(table, f);
-    let (sts, ws): (Vec<[Real; 2]>, Vec<Real>) = gl
-        .iter()
-        .flat_map(|&(a, wa)| gl.iter().map(move |&(b, wb)| ([a, b], wa * wb)))
-        .unzip();
+    let (sts, ws): (Vec<[Real; 2]>, Vec<Real>) = square_rule(gl).into_iter().unzip();
     let samples: Vec<(SampleStencil, Real)> = table
         .stencils(f, &sts)
         .into_iter()

@@ -21,5 +21,5 @@ pub use elements::{
 pub use integrator::{LinearSolver, StepReport, SurfaceDynamics};
 pub use matrices::{MaterialParams, damping_matrix, mass_matrix, stiffness_matrix};
 pub use pcg::{PcgParams, PcgReport, pcg};
-pub use quadrature::{Quadrature, gauss_legendre, patch_samples, quadrature};
+pub use quadrature::{Quadrature, gauss_legendre, patch_samples, quadrature, square_rule};
 pub use sample_rows::{SampleRows, patch_sample_rows};

@@ -63,6 +63,15 @@ pub fn gauss_legendre(n: usize) -> Vec<(Real, Real)> {
     out
 }
 
+/// The tensor rule of the one-dimensional rule `gl` (as
+/// [`gauss_legendre`] gives it) on the unit square: points `[a, b]` with
+/// weights `w_a w_b`, `a` outer.
+pub fn square_rule(gl: &[(Real, Real)]) -> Vec<([Real; 2], Real)> {
+    gl.iter()
+        .flat_map(|&(a, wa)| gl.iter().map(move |&(b, wb)| ([a, b], wa * wb)))
+        .collect()
+}
+
 /// `order × order` Gauss-Legendre points on every polynomial piece of every
 /// patch of `table`.
 pub fn quadrature(table: &PatchTable, order: usize) -> Result<Quadrature> {
@@ -101,10 +110,9 @@ fn quadrature_on(table: &PatchTable, order: usize, per_piece: bool) -> Result<Qu
             for (jac, off) in cells {
                 let inv = invert(jac);
                 let det_inv = (inv[0][0] * inv[1][1] - inv[0][1] * inv[1][0]).abs();
-                let (sts, ws): (Vec<[Real; 2]>, Vec<Real>) = gl
-                    .iter()
-                    .flat_map(|&(a, wa)| gl.iter().map(move |&(b, wb)| (a, b, wa * wb)))
-                    .map(|(a, b, w)| {
+                let (sts, ws): (Vec<[Real; 2]>, Vec<Real>) = square_rule(&gl)
+                    .into_iter()
+                    .map(|([a, b], w)| {
                         let d = [a - off[0], b - off[1]];
                         let st = [
                             inv[0][0] * d[0] + inv[0][1] * d[1],

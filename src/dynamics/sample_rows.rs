@@ -14,8 +14,8 @@
 
 use rayon::prelude::*;
 
-use super::gauss_legendre;
 use super::quadrature::{invert, rows_to_base};
+use super::{gauss_legendre, square_rule};
 use crate::error::{Error, Result};
 use crate::limit::PatchTable;
 use crate::math::Real;
@@ -51,11 +51,7 @@ pub fn patch_sample_rows(table: &PatchTable, order: usize) -> Result<SampleRows>
             "quadrature order {order} must be between 1 and 16"
         )));
     }
-    let gl = gauss_legendre(order);
-    let points: Vec<([Real; 2], Real)> = gl
-        .iter()
-        .flat_map(|&(a, wa)| gl.iter().map(move |&(b, wb)| ([a, b], wa * wb)))
-        .collect();
+    let points = square_rule(&gauss_legendre(order));
     let sts: Vec<[Real; 2]> = points.iter().map(|p| p.0).collect();
     let s = table.to_level();
     let n = table.num_patches();

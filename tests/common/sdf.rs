@@ -50,3 +50,16 @@ pub fn write_raw(dir: &std::path::Path, name: &str, vol: &Volume) -> std::path::
     std::fs::write(dir.join(format!("{name}.json")), header.to_string()).unwrap();
     dir.join(format!("{name}.raw"))
 }
+
+/// A ball of radius 9 centred at (16, 20, 24) with a rod 2 voxels thick
+/// along x from 22 to 36 at y = 20, z = 20, plus deterministic noise of up
+/// to 0.05: in a 42 × 40 × 32 grid its top is cut by the box, and the rod
+/// is thinner than the automatic cage's blocks.
+pub fn noisy_ball_with_rod(p: Point3) -> Real {
+    let c = Point3::new(16.0, 20.0, 24.0);
+    let (from, tip) = (Point3::new(22.0, 20.0, 20.0), Point3::new(36.0, 20.0, 20.0));
+    let t = ((p - from).dot(&(tip - from)) / (tip - from).norm_squared()).clamp(0.0, 1.0);
+    let rod = (p - (from + t * (tip - from))).norm() - 1.0;
+    let noise = 0.05 * ((p.x * 12.9898 + p.y * 78.233 + p.z * 37.719).sin() * 43_758.545).fract();
+    ((p - c).norm() - 9.0).min(rod) + noise
+}

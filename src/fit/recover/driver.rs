@@ -19,7 +19,9 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
 use super::{PreparedVolume, RecoverLevel, RecoverParams, RecoverReport};
-use crate::dynamics::{MaterialParams, PcgParams, SampleRows, gauss_legendre, patch_sample_rows};
+use crate::dynamics::{
+    MaterialParams, PcgParams, SampleRows, gauss_legendre, patch_sample_rows, square_rule,
+};
 use crate::error::{Error, Result};
 use crate::fit::ErrorStats;
 use crate::fit::Refinement;
@@ -479,18 +481,13 @@ fn median_edge_length(mesh: &PolyMesh, p: &[Point3]) -> Real {
 }
 
 /// The `order × order` Gauss-Legendre points of every patch of `table`, as
-/// [`patch_sample_rows`] takes them (patch after patch, `s` outer).
+/// [`patch_sample_rows`] takes them (patch after patch, [`square_rule`]'s
+/// order within a patch).
 fn gauss_points(table: &PatchTable, order: usize) -> Vec<(usize, [Real; 2])> {
-    let gl = gauss_legendre(order);
-    let mut at = Vec::with_capacity(table.num_patches() * gl.len() * gl.len());
-    for f in 0..table.num_patches() {
-        for &(a, _) in &gl {
-            for &(b, _) in &gl {
-                at.push((f, [a, b]));
-            }
-        }
-    }
-    at
+    let rule = square_rule(&gauss_legendre(order));
+    (0..table.num_patches())
+        .flat_map(|f| rule.iter().map(move |&(st, _)| (f, st)))
+        .collect()
 }
 
 /// The points of `from` outside the limit surface of `engine` (whose
