@@ -193,6 +193,64 @@ fn a_part_missing_from_the_cage_grows_back_by_the_two_sided_forces() {
 }
 
 #[test]
+fn adaptive_levels_keep_within_the_control_point_budget() {
+    // The ball-and-rod volume from its automatic cage, refined adaptively;
+    // its iso-surface points set the budget.
+    let c = Point3::new(16.0, 20.0, 20.0);
+    let sdf = move |p: Point3| {
+        let t = ((p.x - 22.0) / 14.0).clamp(0.0, 1.0);
+        let rod = (p - Point3::new(22.0 + 14.0 * t, 20.0, 20.0)).norm() - 2.0;
+        ((p - c).norm() - 9.0).min(rod)
+    };
+    let vol = sdf_volume([42, 40, 40], [1.0; 3], sdf);
+    let run = |share: Real| {
+        // A tolerance that level 0 cannot meet, so that levels are added.
+        let params = RecoverParams {
+            boundary: BoundaryModel::Iso { value: 0.5 },
+            max_control_share: share,
+            tolerance_voxels: 0.05,
+            min_edge_voxels: 0.5,
+            ..Default::default()
+        };
+        let prepared = prepare_volume(&vol, &params).unwrap();
+        let cage = component_cage(&prepared.smoothed, 0.5, true, None, 6).unwrap();
+        let boundary = cage.boundary;
+        let out = recover_shape(
+            &prepared,
+            &cage.mesh,
+            &[],
+            &boundary,
+            &params,
+            &mut |_, _, _| {},
+        )
+        .unwrap();
+        println!(
+            "share {share}: {} control points of {} iso points; {}",
+            out.control.num_vertices(),
+            boundary.len(),
+            out.report.stop_reason
+        );
+        (out, boundary.len())
+    };
+    let (free, n) = run(1.0);
+    let seed_points = free.report.levels[0].control_points;
+    assert!(
+        free.control.num_vertices() > 2 * seed_points,
+        "no refinement to limit"
+    );
+    // A budget between the seed cage and the unlimited result binds.
+    let share = (seed_points + free.control.num_vertices()) as Real / (2 * n) as Real;
+    let (held, _) = run(share);
+    assert!(
+        held.control.num_vertices() as Real <= share * n as Real,
+        "{} control points over the budget {}",
+        held.control.num_vertices(),
+        share * n as Real
+    );
+    assert!(held.control.num_vertices() > seed_points);
+}
+
+#[test]
 fn the_recover_verb_writes_the_shape_report_and_slices_and_rejects_bad_input() {
     let dir = tempfile::tempdir().unwrap();
     let c = Point3::new(16.0, 16.0, 16.0);

@@ -42,6 +42,7 @@ const RECOVER_OPTIONS: &[&str] = &[
     "max_unmatched",
     "refine",
     "max_level_growth",
+    "max_control_share",
     "bending",
     "tess",
     "quads",
@@ -98,6 +99,7 @@ pub fn recover<'py>(
             _ => Refinement::Adaptive,
         },
         max_level_growth: o.f64("max_level_growth", d.max_level_growth)?,
+        max_control_share: o.f64("max_control_share", d.max_control_share)?,
         ..d
     };
     params.check().map_err(crate::arrays::py_err)?;

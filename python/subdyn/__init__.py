@@ -172,7 +172,7 @@ def recover(volume: Any, spacing: Sequence[float] = (1.0, 1.0, 1.0),
     ``auto``, ``seed`` ((x, y, z)), ``seed_radius``, ``resolution``,
     ``points_weight``, ``two_sided_weight``, ``two_sided_distance``
     (voxels), ``max_unmatched``, ``refine`` ("adaptive" or "uniform"),
-    ``max_level_growth``, ``bending``, ``tess``, ``quads``, ``threads``, ``accept_poor``, ``open_at_box`` (an object cut by the volume's box is
+    ``max_level_growth``, ``max_control_share``, ``bending``, ``tess``, ``quads``, ``threads``, ``accept_poor``, ``open_at_box`` (an object cut by the volume's box is
     left open there, its rim on the box face; by default it closes on the
     face). A poor result (the surface leaves the volume's box, much
     of it found no boundary, or a level got worse) raises ``ValueError``

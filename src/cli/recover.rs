@@ -118,6 +118,10 @@ pub struct RecoverArgs {
     /// An adaptive level has at most this many times its parent's control points.
     #[arg(long, value_name = "F", default_value_t = RecoverParams::default().max_level_growth)]
     pub max_level_growth: f64,
+    /// Adaptive levels stop adding control points at this share of the
+    /// object's iso-surface points (marching cubes' vertex count).
+    #[arg(long, value_name = "F", default_value_t = RecoverParams::default().max_control_share)]
+    pub max_control_share: f64,
     /// Bending weight λ_b of the thin plate.
     #[arg(long, value_name = "λ", default_value_t = RecoverParams::default().bending)]
     pub bending: f64,
@@ -223,6 +227,7 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
             RefineMode::Uniform => Refinement::Uniform,
         },
         max_level_growth: args.max_level_growth,
+        max_control_share: args.max_control_share,
         ..Default::default()
     };
     params.check()?;

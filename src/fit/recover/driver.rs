@@ -427,8 +427,25 @@ pub fn recover_shape(
                         ),
                     );
                 }
-                let cap = params.max_level_growth * mesh.num_vertices() as Real;
-                split_within(&mesh, &h, &rank, cap)?.1.mesh
+                let budget = params.max_control_share * boundary.len() as Real;
+                let cap = if boundary.is_empty() {
+                    params.max_level_growth * mesh.num_vertices() as Real
+                } else {
+                    budget.min(params.max_level_growth * mesh.num_vertices() as Real)
+                };
+                let next = split_within(&mesh, &h, &rank, cap)?.1.mesh;
+                if next.num_vertices() as Real > cap {
+                    break (
+                        false,
+                        format!(
+                            "splitting any face of level {level} ({} control points) would pass the budget of {budget:.0} ({:.0} % of the {} iso-surface points)",
+                            mesh.num_vertices(),
+                            100.0 * params.max_control_share,
+                            boundary.len()
+                        ),
+                    );
+                }
+                next
             }
         };
         coarser = Some(std::mem::replace(&mut mesh, next));

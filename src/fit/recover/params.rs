@@ -120,6 +120,12 @@ pub struct RecoverParams {
     /// (folded surfaces such as a brain's have far points everywhere, and
     /// splitting all their faces costs the memory of a uniform level).
     pub max_level_growth: Real,
+    /// Adaptive levels stop adding control points at this share of the
+    /// object's iso-surface points (the crossings of the iso-level on voxel
+    /// edges, which are marching cubes' vertices; default 0.1): the surface
+    /// keeps at least ten times fewer degrees of freedom than a voxel-level
+    /// mesh, so refining cannot end up fitting the voxel noise.
+    pub max_control_share: Real,
 }
 
 impl Default for RecoverParams {
@@ -148,6 +154,7 @@ impl Default for RecoverParams {
             max_unmatched: 0.05,
             refinement: Refinement::Adaptive,
             max_level_growth: 2.0,
+            max_control_share: 0.1,
         }
     }
 }
@@ -213,6 +220,7 @@ impl RecoverParams {
         non_negative("points weight", self.points_weight)?;
         non_negative("two-sided weight", self.two_sided_weight)?;
         positive("two-sided distance", self.two_sided_voxels)?;
+        positive("max control share", self.max_control_share)?;
         if !(self.max_level_growth.is_finite() && self.max_level_growth > 1.0) {
             return Err(Error::Input(format!(
                 "max level growth {} must be a number above 1",
