@@ -40,8 +40,12 @@ fn refinement(c: &mut Criterion) {
             let mut sharp = refiner.sharpness.clone();
             let mut tables: Vec<StencilTable> = Vec::new();
             for k in 0..LEVELS {
-                let (t, next) =
-                    refine_stencil(&hierarchy.levels[k], &sharp, &hierarchy.levels[k + 1]);
+                let (t, next) = refine_stencil(
+                    &hierarchy.levels[k],
+                    &sharp,
+                    &hierarchy.levels[k + 1],
+                    false,
+                );
                 tables.push(t);
                 sharp = next;
             }

@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 use serde_json::Value;
+use subdyn::io::read_mesh;
 use subdyn::math::{Point3, Vector3};
 
 fn stdout(out: &Output) -> String {
@@ -462,7 +463,12 @@ fn bad_crease_file() {
         dir.path(),
         &["subdivide", "-o", "o.obj", "--creases", "c.txt"],
     );
-    assert_clean_failure(dir.path(), &out, &["c.txt:1", "3 columns"], &["c.txt"]);
+    assert_clean_failure(
+        dir.path(),
+        &out,
+        &["c.txt:1", "found 2 columns"],
+        &["c.txt"],
+    );
 }
 
 #[test]
@@ -931,4 +937,137 @@ fn fit_bad_inputs_are_one_line_errors() {
             &["nan.xyz", "sphere.xyz", "three.xyz"],
         );
     }
+}
+
+#[test]
+fn subdivide_reads_opensubdiv_tags_and_leaves_holes_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let shapes = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/opensubdiv-regression");
+    let shape = |n: &str| shapes.join(format!("{n}.obj")).display().to_string();
+    let faces = |out: &str| read_mesh(dir.path().join(out)).unwrap().num_faces();
+    // `t hole 1/0/0 1`: one of the cube's six faces is a hole.
+    ok(&run_subdyn(
+        dir.path(),
+        &[
+            "subdivide",
+            &shape("hole_test1"),
+            "--levels",
+            "2",
+            "-o",
+            "h.obj",
+        ],
+    ));
+    assert_eq!(faces("h.obj"), 5 * 16);
+    // `t interpolateboundary 1/0/0 0` (none): the faces at the untagged
+    // boundary go; `--boundary edge-only` on the command line wins.
+    ok(&run_subdyn(
+        dir.path(),
+        &[
+            "subdivide",
+            &shape("edgenone"),
+            "--levels",
+            "1",
+            "-o",
+            "n.obj",
+        ],
+    ));
+    ok(&run_subdyn(
+        dir.path(),
+        &[
+            "subdivide",
+            &shape("edgenone"),
+            "--levels",
+            "1",
+            "-o",
+            "e.obj",
+            "--boundary",
+            "edge-only",
+        ],
+    ));
+    assert_eq!(faces("e.obj"), 4 * 36);
+    assert_eq!(faces("n.obj"), 4 * (36 - 23));
+    // chaikin0 and chaikin1 are the same mesh, the second tagged
+    // `t creasemethod 0/0/1 chaikin`: the flag gives the tag's points.
+    ok(&run_subdyn(
+        dir.path(),
+        &[
+            "subdivide",
+            &shape("chaikin1"),
+            "--levels",
+            "2",
+            "-o",
+            "c1.obj",
+        ],
+    ));
+    ok(&run_subdyn(
+        dir.path(),
+        &[
+            "subdivide",
+            &shape("chaikin0"),
+            "--levels",
+            "2",
+            "-o",
+            "c0.obj",
+            "--crease-method",
+            "chaikin",
+        ],
+    ));
+    ok(&run_subdyn(
+        dir.path(),
+        &[
+            "subdivide",
+            &shape("chaikin0"),
+            "--levels",
+            "2",
+            "-o",
+            "u0.obj",
+        ],
+    ));
+    let points = |out: &str| read_mesh(dir.path().join(out)).unwrap().positions;
+    assert_eq!(points("c0.obj"), points("c1.obj"));
+    assert_ne!(points("u0.obj"), points("c1.obj"));
+    // A tag file's vertex and hole lines; a bad index is one clear line.
+    write(dir.path(), "t.creases", b"v 0 10\nh 2\n");
+    ok(&run_subdyn(
+        dir.path(),
+        &[
+            "subdivide",
+            &shape("cube"),
+            "--levels",
+            "1",
+            "-o",
+            "t.obj",
+            "--creases",
+            "t.creases",
+        ],
+    ));
+    assert_eq!(faces("t.obj"), 5 * 4);
+    assert_eq!(
+        points("t.obj")
+            .iter()
+            .filter(|p| **p == read_mesh(shape("cube")).unwrap().positions[0])
+            .count(),
+        1
+    );
+    write(dir.path(), "bad.creases", b"h 6\n");
+    let out = run_subdyn(
+        dir.path(),
+        &[
+            "subdivide",
+            &shape("cube"),
+            "--levels",
+            "1",
+            "-o",
+            "b.obj",
+            "--creases",
+            "bad.creases",
+        ],
+    );
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("bad.creases: hole 0: face 6 is not in the mesh"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!dir.path().join("b.obj").exists());
 }

@@ -286,6 +286,7 @@ fn equal_intervals_reproduce_uniform_catmull_clark() {
         let options = RefineOptions {
             boundary: BoundaryRule::EdgeAndCorner,
             creases: Vec::new(),
+            ..Default::default()
         };
         let uniform = Refiner::new(&mesh, &options)
             .unwrap()

@@ -13,6 +13,8 @@ use subdyn::Error;
 use subdyn::io::*;
 use subdyn::math::{Point3, Vector3};
 use subdyn::mesh::{PointCloud, PolyMesh};
+use subdyn::subdivision::{BoundaryRule, TriangleRule};
+use subdyn::topology::CreaseMethod;
 
 /// A fixture under `tests/data/io/`.
 fn data(name: &str) -> PathBuf {
@@ -770,7 +772,7 @@ fn formats_follow_extensions_case_insensitively_through_gz() {
 
 #[test]
 fn creases_are_read_with_comments_and_infinite_sharpness() {
-    let creases = read_creases(data("creases.txt")).unwrap();
+    let creases = read_tags(data("creases.txt")).unwrap().creases;
     assert_eq!(
         creases,
         vec![(0, 1, 2.5), (1, 2, f64::INFINITY), (3, 0, 0.0)]
@@ -778,19 +780,69 @@ fn creases_are_read_with_comments_and_infinite_sharpness() {
 }
 
 #[test]
+fn tag_files_and_obj_tags_give_vertex_sharpness_and_holes() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = file(
+        &dir,
+        "t.creases",
+        b"# edges, vertices, holes\n0 1 2\nv 3 1.5\nh 4\nv 2 inf\n",
+    );
+    let tags = read_tags(&path).unwrap();
+    assert_eq!(tags.creases, vec![(0, 1, 2.0)]);
+    assert_eq!(tags.corners, vec![(3, 1.5), (2, f64::INFINITY)]);
+    assert_eq!(tags.holes, vec![4]);
+    // OpenSubdiv's tag lines: a crease chain with one sharpness per edge,
+    // corners with one sharpness for all, holes, the scheme options.
+    let obj = file(
+        &dir,
+        "s.obj",
+        b"v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n\
+          t crease 3/2/0 0 1 2 1.5 3\nt corner 2/1/0 0 2 4.0\nt hole 1/0/0 0\n\
+          t interpolateboundary 1/0/0 2\nt creasemethod 0/0/1 chaikin\n\
+          t smoothtriangles 0/0/1 smooth\nt vertexedit 1/1/0 0 1.0\n",
+    );
+    let tags = read_obj_tags(&obj).unwrap();
+    assert_eq!(tags.tags.creases, vec![(0, 1, 1.5), (1, 2, 3.0)]);
+    assert_eq!(tags.tags.corners, vec![(0, 4.0), (2, 4.0)]);
+    assert_eq!(tags.tags.holes, vec![0]);
+    assert_eq!(tags.boundary, Some(BoundaryRule::EdgeOnly));
+    assert_eq!(tags.crease_method, Some(CreaseMethod::Chaikin));
+    assert_eq!(tags.triangles, Some(TriangleRule::Smooth));
+    assert_eq!(tags.ignored, vec!["vertexedit".to_string()]);
+    // The mesh itself reads as before.
+    assert_eq!(read_mesh(&obj).unwrap().num_faces(), 1);
+    for (text, expected) in [
+        (&b"t crease 2/1/0 0 1\n"[..], "announces 2 ints, 1 floats"),
+        (b"t crease 3/2/0 0 1 2 1 2 3\n", "announces"),
+        (b"t crease 3/3/0 0 1 2 1 2 3\n", "expected 1 or 2"),
+        (b"t interpolateboundary 1/0/0 7\n", "takes one of 0, 1, 2"),
+        (b"t corner 1/1/0 0 -2\n", "sharpness must be"),
+    ] {
+        let bad = file(&dir, "bad.obj", text);
+        let err = read_obj_tags(&bad).unwrap_err().to_string();
+        assert!(
+            err.contains("bad.obj:1:") && err.contains(expected),
+            "{err}"
+        );
+    }
+}
+
+#[test]
 fn bad_creases_name_file_and_line() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&[u8], &str); 6] = [
+    let cases: [(&[u8], &str); 8] = [
         (b"0 1 1\n# c\n2 3 -1\n", "sharpness must be"),
+        (b"0 1 1\n# c\nv 3 -1\n", "sharpness must be"),
+        (b"0 1 1\n# c\nh x\n", "non-negative integer"),
         (b"0 1 1\n# c\n2 3 nan\n", "sharpness must be"),
         (b"0 1 1\n\n4 4 1\n", "two different vertices"),
-        (b"0 1 1\n\n4 5\n", "expected 3 columns"),
-        (b"0 1 1\n\n4 5 1 2\n", "expected 3 columns"),
+        (b"0 1 1\n\n4 5\n", "found 2 columns"),
+        (b"0 1 1\n\n4 5 1 2\n", "found 4 columns"),
         (b"0 1 1\n\n-4 5 1\n", "non-negative integer"),
     ];
     for (bytes, expected) in cases {
         let path = file(&dir, "bad.creases", bytes);
-        let err = read_creases(&path).unwrap_err();
+        let err = read_tags(&path).unwrap_err();
         assert!(err.to_string().contains("bad.creases:3:"), "{err}");
         let (line, message) = parse_error::<()>(Err(err));
         assert_eq!(line, 3);

@@ -23,7 +23,7 @@ mod common;
 use std::path::PathBuf;
 
 use common::{BfrSample, descendant, max_nearest, read_bfr, read_xyz};
-use subdyn::io::{read_creases, read_mesh};
+use subdyn::io::{read_mesh, read_tags};
 use subdyn::limit::{LimitEvaluator, limit_stencil};
 use subdyn::math::Point3;
 use subdyn::math::bbox_diagonal;
@@ -44,11 +44,16 @@ fn setup(name: &str, boundary: BoundaryRule) -> (PolyMesh, Refiner) {
     let mesh = read_mesh(file(&format!("{name}.obj"))).expect("reference mesh");
     let creases_path = file(&format!("{name}.creases"));
     let creases = if creases_path.exists() {
-        read_creases(&creases_path).expect("crease file")
+        read_tags(&creases_path).expect("crease file").creases
     } else {
         Vec::new()
     };
-    let refiner = Refiner::new(&mesh, &RefineOptions { boundary, creases }).expect("valid mesh");
+    let options = RefineOptions {
+        boundary,
+        creases,
+        ..Default::default()
+    };
+    let refiner = Refiner::new(&mesh, &options).expect("valid mesh");
     (mesh, refiner)
 }
 

@@ -44,6 +44,7 @@ pub fn refine_options(
     Ok(RefineOptions {
         boundary,
         creases: list,
+        ..Default::default()
     })
 }
 

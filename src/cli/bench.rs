@@ -253,7 +253,7 @@ fn measure(args: &BenchSubdivideArgs, progress: &Progress) -> anyhow::Result<Tim
             } else {
                 &children[k - 1]
             };
-            let (table, next) = refine_stencil(parent, &sharp, child);
+            let (table, next) = refine_stencil(parent, &sharp, child, false);
             tables.push(table);
             sharp = next;
         }

@@ -83,7 +83,7 @@ pub fn run(args: &LimitArgs) -> anyhow::Result<()> {
     }
 
     progress.stage("building the topology");
-    let (refiner, topology_s) = timed(|| args.refine.refiner(&mesh, &name));
+    let (refiner, topology_s) = timed(|| args.refine.refiner(&mesh, &args.input));
     let refiner = refiner?;
     progress.stage(format!(
         "tessellating the limit surface ({0}×{0} per quad)",
@@ -107,8 +107,10 @@ pub fn run(args: &LimitArgs) -> anyhow::Result<()> {
             "tess": args.tess,
             "normals": args.normals,
             "quads": args.faces.quads,
-            "boundary": args.refine.boundary.name(),
+            "boundary": refiner.options.boundary.name(),
             "creases": refiner.options.creases.len(),
+            "corners": refiner.options.corners.len(),
+            "holes": refiner.options.holes.len(),
             "control": {"vertices": mesh.num_vertices(), "faces": mesh.num_faces()},
             "tessellation": {"vertices": out.num_vertices(), "faces": out.num_faces()},
             "timings_s": {

@@ -6,9 +6,10 @@ use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 
-use subdyn::io::{read_creases, read_mesh};
+use subdyn::io::{read_mesh, read_obj_tags, read_tags};
 use subdyn::mesh::PolyMesh;
-use subdyn::subdivision::{BoundaryRule, RefineOptions, Refiner};
+use subdyn::subdivision::{BoundaryRule, RefineOptions, Refiner, TriangleRule};
+use subdyn::topology::CreaseMethod;
 
 use super::common::{about_file, thousands, warn};
 
@@ -20,6 +21,8 @@ pub enum Boundary {
     EdgeAndCorner,
     /// Boundary edges sharp, no corners.
     EdgeOnly,
+    /// No surface along the boundary: the faces at boundary vertices are holes.
+    None,
 }
 
 impl Boundary {
@@ -28,47 +31,96 @@ impl Boundary {
         match self {
             Boundary::EdgeAndCorner => BoundaryRule::EdgeAndCorner,
             Boundary::EdgeOnly => BoundaryRule::EdgeOnly,
-        }
-    }
-
-    /// The command-line spelling.
-    pub fn name(self) -> &'static str {
-        match self {
-            Boundary::EdgeAndCorner => "edge-and-corner",
-            Boundary::EdgeOnly => "edge-only",
+            Boundary::None => BoundaryRule::None,
         }
     }
 }
 
-/// `--boundary` and `--creases`.
+/// How semi-sharp creases decay, as on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum CreaseMethodArg {
+    /// Sharpness − 1 per level.
+    #[default]
+    Uniform,
+    /// Each half of an edge towards the mean of its semi-sharp neighbours (OpenSubdiv's Chaikin).
+    Chaikin,
+}
+
+/// The edge rule next to triangles, as on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum TriangleRuleArg {
+    /// Catmull-Clark's rule.
+    #[default]
+    Catmark,
+    /// OpenSubdiv's smooth-triangle rule (face weight 0.47 next to a triangle).
+    Smooth,
+}
+
+/// `--boundary`, `--creases`, `--crease-method` and `--triangle-rule`. An
+/// OBJ input's own OpenSubdiv tags (`t crease`, `t corner`, `t hole`,
+/// `t interpolateboundary`, `t creasemethod`, `t smoothtriangles`) apply
+/// too; a flag given on the command line wins over the file's tag.
 #[derive(Clone, Debug, Args)]
 pub struct RefineArgs {
-    /// Boundary rule.
-    #[arg(long, value_enum, default_value_t = Boundary::EdgeAndCorner)]
-    pub boundary: Boundary,
-    /// Crease file: one line `i j s` per sharp edge (0-based vertex indices,
-    /// sharpness s; s ≥ 10 or `inf` is infinitely sharp).
+    /// Boundary rule (default edge-and-corner, or the OBJ's `t interpolateboundary`).
+    #[arg(long, value_enum)]
+    pub boundary: Option<Boundary>,
+    /// Tag file: lines `i j s` (the edge between vertices i and j has
+    /// sharpness s), `v i s` (vertex i has sharpness s: a corner while it
+    /// lasts) and `h f` (face f is a hole); 0-based indices, s ≥ 10 or
+    /// `inf` infinitely sharp.
     #[arg(long, value_name = "FILE")]
     pub creases: Option<PathBuf>,
+    /// How semi-sharp creases decay (default uniform, or the OBJ's `t creasemethod`).
+    #[arg(long, value_enum)]
+    pub crease_method: Option<CreaseMethodArg>,
+    /// The edge rule next to triangles (default catmark, or the OBJ's `t smoothtriangles`).
+    #[arg(long, value_enum)]
+    pub triangle_rule: Option<TriangleRuleArg>,
 }
 
 impl RefineArgs {
-    /// Reads the crease file (if any) and builds the level-0 topology of
-    /// `mesh`; errors name the mesh (`mesh_name`) or the crease file.
-    pub fn refiner(&self, mesh: &PolyMesh, mesh_name: &str) -> anyhow::Result<Refiner> {
-        let creases = match &self.creases {
-            Some(path) => read_creases(path).map_err(|e| about_file(e, path))?,
-            None => Vec::new(),
-        };
-        let options = RefineOptions {
-            boundary: self.boundary.rule(),
-            creases,
-        };
+    /// Reads the OBJ tags of `mesh_path` (for an `.obj` or `.obj.gz`) and the
+    /// tag file (if any), and builds the level-0 topology of `mesh`; errors
+    /// name the mesh or the tag file.
+    pub fn refiner(&self, mesh: &PolyMesh, mesh_path: &Path) -> anyhow::Result<Refiner> {
+        let mesh_name = mesh_path.display().to_string();
+        let name = mesh_name.to_ascii_lowercase();
+        let mut options = RefineOptions::default();
+        if name.ends_with(".obj") || name.ends_with(".obj.gz") {
+            let tags = read_obj_tags(mesh_path).map_err(|e| about_file(e, mesh_path))?;
+            options = tags.apply(options);
+        }
+        if let Some(path) = &self.creases {
+            let tags = read_tags(path).map_err(|e| about_file(e, path))?;
+            options.creases.extend(tags.creases);
+            options.corners.extend(tags.corners);
+            options.holes.extend(tags.holes);
+        }
+        if let Some(b) = self.boundary {
+            options.boundary = b.rule();
+        }
+        if let Some(m) = self.crease_method {
+            options.crease_method = match m {
+                CreaseMethodArg::Uniform => CreaseMethod::Uniform,
+                CreaseMethodArg::Chaikin => CreaseMethod::Chaikin,
+            };
+        }
+        if let Some(t) = self.triangle_rule {
+            options.triangles = match t {
+                TriangleRuleArg::Catmark => TriangleRule::Catmark,
+                TriangleRuleArg::Smooth => TriangleRule::Smooth,
+            };
+        }
         Refiner::new(mesh, &options).map_err(|e| match (&self.creases, &e) {
-            (Some(path), subdyn::Error::Input(msg)) if msg.starts_with("crease") => {
+            (Some(path), subdyn::Error::Input(msg))
+                if ["crease", "vertex sharpness", "hole"]
+                    .iter()
+                    .any(|p| msg.starts_with(p)) =>
+            {
                 anyhow::anyhow!("{}: {msg} (the mesh is {mesh_name})", path.display())
             }
-            _ => anyhow::Error::new(e).context(mesh_name.to_string()),
+            _ => anyhow::Error::new(e).context(mesh_name),
         })
     }
 }

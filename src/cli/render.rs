@@ -286,7 +286,7 @@ fn limit_surface(
             thousands(MAX_LIMIT_FACES as usize)
         );
     }
-    let refiner = args.refine.refiner(mesh, name)?;
+    let refiner = args.refine.refiner(mesh, Path::new(name))?;
     tessellate(&refiner, &mesh.positions, k).map_err(|e| about_file(e, Path::new(name)))
 }
 

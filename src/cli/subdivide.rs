@@ -86,7 +86,7 @@ pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
     }
 
     progress.stage("building the topology");
-    let (refiner, topology_s) = timed(|| args.refine.refiner(&mesh, &input_name));
+    let (refiner, topology_s) = timed(|| args.refine.refiner(&mesh, Path::new(&input_name)));
     let refiner = refiner?;
     progress.stage(format!("refining to level {}", args.levels));
     let (hierarchy, refine_s) = timed(|| refiner.refine_uniform(args.levels));
@@ -139,8 +139,10 @@ pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
             "input": input_label,
             "output": args.output.display().to_string(),
             "levels": args.levels,
-            "boundary": args.refine.boundary.name(),
+            "boundary": refiner.options.boundary.name(),
             "creases": refiner.options.creases.len(),
+            "corners": refiner.options.corners.len(),
+            "holes": refiner.options.holes.len(),
             "limit": args.limit,
             "counts": counts,
             "timings_s": {

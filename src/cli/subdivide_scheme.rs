@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::ValueEnum;
 
-use subdyn::io::read_creases;
+use subdyn::io::read_tags;
 use subdyn::math::Real;
 use subdyn::mesh::PolyMesh;
 use subdyn::subdivision::{NonUniformHierarchy, doo_sabin_refine};
@@ -42,7 +42,14 @@ impl Scheme {
 pub fn knot_intervals(level: &Level, knots: Option<&PathBuf>) -> anyhow::Result<Vec<Real>> {
     let mut d = vec![1.0; level.num_edges()];
     if let Some(path) = knots {
-        for (i, j, s) in read_creases(path).map_err(|e| about_file(e, path))? {
+        let tags = read_tags(path).map_err(|e| about_file(e, path))?;
+        if !tags.corners.is_empty() || !tags.holes.is_empty() {
+            anyhow::bail!(
+                "{}: a knot file has `i j interval` lines only (found vertex or hole lines)",
+                path.display()
+            );
+        }
+        for (i, j, s) in tags.creases {
             let e = find_edge(level, i, j).ok_or_else(|| {
                 anyhow::anyhow!(
                     "{}: vertices {i} and {j} are not joined by an edge",

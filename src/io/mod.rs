@@ -31,7 +31,7 @@ mod xyz;
 
 pub use atomic::{atomic_write, check_writable, remove_temporary_files};
 pub use batch::{OutputBatch, check_output_dir_path, create_output_dir};
-pub use creases::read_creases;
+pub use creases::{ObjTags, SubdivisionTags, read_obj_tags, read_tags};
 pub use format::MeshFormat;
 pub use lattice::{
     LATTICE_FORMAT, lattice_from_json, lattice_to_json, read_lattice, write_lattice,

@@ -100,7 +100,8 @@ impl LocalPatch {
     /// its `face` is the child at corner 0.
     pub(crate) fn refined(&self) -> LocalPatch {
         let child = refine_topology(&self.level);
-        let (s, child_sharp) = refine_stencil(&self.level, &self.sharp, &child);
+        // The smooth-triangle rule is not carried here (see `TriangleRule`).
+        let (s, child_sharp) = refine_stencil(&self.level, &self.sharp, &child, false);
         let nc = self.ncols();
         let mut rows = vec![0.0; child.num_vertices * nc];
         for (cv, out) in rows
@@ -279,7 +280,18 @@ impl Ring {
             })
             .collect();
         let vertex = map.iter().map(|&v| sharp.vertex[v as usize]).collect();
-        ((sub, Sharpness { edge, vertex }, 0), map)
+        (
+            (
+                sub,
+                Sharpness {
+                    edge,
+                    vertex,
+                    method: sharp.method,
+                },
+                0,
+            ),
+            map,
+        )
     }
 }
 

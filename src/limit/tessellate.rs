@@ -80,7 +80,8 @@ pub fn tessellate(
     let table = PatchTable::new(refiner, positions, 1)?;
     let split = (0..level.num_faces()).any(|f| level.face_vertices(f).len() != 4);
     let mut tiles = Vec::new();
-    for f in 0..level.num_faces() {
+    // Hole faces are left out (they still shape their neighbours).
+    for f in (0..level.num_faces()).filter(|&f| !refiner.holes.get(f).copied().unwrap_or(false)) {
         let fv = level.face_vertices(f);
         let fe = level.face_edge_list(f);
         let n = fv.len();

@@ -20,7 +20,7 @@ pub use doo_sabin::{
 pub use local_refine::{CornerImage, LocalRefinement, close_marks, refine_marked};
 pub use non_uniform::{NonUniformHierarchy, check_intervals, non_uniform_step};
 pub use refine_topology::refine_topology;
-pub use refiner::{BoundaryRule, Hierarchy, RefineOptions, Refiner};
+pub use refiner::{BoundaryRule, Hierarchy, RefineOptions, Refiner, TriangleRule};
 pub use uniform::{
     MAX_FACES, MAX_LEVELS, check_refinement_memory, check_uniform_size, estimated_faces,
     uniform_positions,

@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::mesh::PolyMesh;
 use crate::stencil::StencilTable;
-use crate::topology::{Level, Sharpness};
+use crate::topology::{CreaseMethod, Level, SHARPNESS_INFINITE, Sharpness};
 
 use super::{refine_stencil, refine_topology};
 
@@ -21,6 +21,46 @@ pub enum BoundaryRule {
     /// Boundary edges are sharp; valence-2 boundary vertices follow the
     /// boundary curve rule like any other boundary vertex.
     EdgeOnly,
+    /// No surface along the boundary: the faces around every boundary vertex
+    /// become holes, except where the vertex's boundary edges were tagged
+    /// infinitely sharp (OpenSubdiv's `VTX_BOUNDARY_NONE`; the points are
+    /// those of [`BoundaryRule::EdgeOnly`]).
+    None,
+}
+
+/// The edge-point rule next to triangles (OpenSubdiv's `TriangleSubdivision`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TriangleRule {
+    /// Catmull and Clark's rule for every face. The default.
+    #[default]
+    Catmark,
+    /// Edges of a triangle weight its face point 0.47 instead of ¼
+    /// (OpenSubdiv's `TRI_SUB_SMOOTH`), which rounds meshes of triangles better.
+    Smooth,
+}
+
+impl FromStr for TriangleRule {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "catmark" => Ok(TriangleRule::Catmark),
+            "smooth" => Ok(TriangleRule::Smooth),
+            _ => Err(Error::Input(format!(
+                "unknown triangle rule '{s}': expected catmark or smooth"
+            ))),
+        }
+    }
+}
+
+impl BoundaryRule {
+    /// The command-line spelling.
+    pub fn name(self) -> &'static str {
+        match self {
+            BoundaryRule::EdgeAndCorner => "edge-and-corner",
+            BoundaryRule::EdgeOnly => "edge-only",
+            BoundaryRule::None => "none",
+        }
+    }
 }
 
 impl FromStr for BoundaryRule {
@@ -29,8 +69,9 @@ impl FromStr for BoundaryRule {
         match s {
             "edge-and-corner" => Ok(BoundaryRule::EdgeAndCorner),
             "edge-only" => Ok(BoundaryRule::EdgeOnly),
+            "none" => Ok(BoundaryRule::None),
             _ => Err(Error::Input(format!(
-                "unknown boundary rule '{s}': expected edge-and-corner or edge-only"
+                "unknown boundary rule '{s}': expected edge-and-corner, edge-only or none"
             ))),
         }
     }
@@ -44,6 +85,17 @@ pub struct RefineOptions {
     /// Creases `(i, j, s)`: the edge joining vertices `i` and `j` gets
     /// sharpness `s` (≥ 10 is infinite). Default: none.
     pub creases: Vec<(u32, u32, Real)>,
+    /// Vertex sharpness `(v, s)`: vertex `v` is a corner while `s` lasts
+    /// (decaying by 1 per level; ≥ 10 is infinite). Default: none.
+    pub corners: Vec<(u32, Real)>,
+    /// Faces that are holes: refined and used by their neighbours' rules,
+    /// but not part of the surface (left out of refined meshes and limit
+    /// tessellations). Default: none.
+    pub holes: Vec<u32>,
+    /// How semi-sharp creases decay; default uniform.
+    pub crease_method: CreaseMethod,
+    /// The edge rule next to triangles; default Catmull-Clark's.
+    pub triangles: TriangleRule,
 }
 
 /// Level-0 topology with its sharpness tags, ready to refine.
@@ -63,6 +115,8 @@ pub struct Refiner {
     pub level: Level,
     /// Level-0 sharpness.
     pub sharpness: Sharpness,
+    /// Level-0 hole faces (empty when there are none).
+    pub holes: Vec<bool>,
     /// The options it was built with.
     pub options: RefineOptions,
 }
@@ -76,6 +130,10 @@ pub struct Hierarchy {
     pub sharpness: Vec<Sharpness>,
     /// `stencils[k]` maps level `k` to level `k + 1`.
     pub stencils: Vec<StencilTable>,
+    /// `holes[k]` marks the hole faces of level `k` (empty: none).
+    pub holes: Vec<Vec<bool>>,
+    /// The edge rule next to triangles.
+    pub triangles: TriangleRule,
 }
 
 impl Refiner {
@@ -85,11 +143,29 @@ impl Refiner {
         let sharpness = Sharpness::initial(
             &level,
             &options.creases,
+            &options.corners,
             options.boundary == BoundaryRule::EdgeAndCorner,
+            options.crease_method,
         )?;
+        let mut holes = vec![false; level.num_faces()];
+        for (k, &f) in options.holes.iter().enumerate() {
+            *holes.get_mut(f as usize).ok_or_else(|| {
+                Error::Input(format!(
+                    "hole {k}: face {f} is not in the mesh ({} faces)",
+                    level.num_faces()
+                ))
+            })? = true;
+        }
+        if options.boundary == BoundaryRule::None {
+            boundary_holes(&level, &options.creases, &mut holes);
+        }
+        if !holes.contains(&true) {
+            holes.clear();
+        }
         Ok(Refiner {
             level,
             sharpness,
+            holes,
             options: options.clone(),
         })
     }
@@ -106,6 +182,8 @@ impl Refiner {
             levels: vec![self.level.clone()],
             sharpness: vec![self.sharpness.clone()],
             stencils: Vec::with_capacity(levels),
+            holes: vec![self.holes.clone()],
+            triangles: self.options.triangles,
         };
         for _ in 0..levels {
             h.push_level();
@@ -119,10 +197,26 @@ impl Hierarchy {
     pub fn push_level(&mut self) {
         let (parent, sharp) = (self.finest(), self.sharpness.last().expect("level 0"));
         let child = refine_topology(parent);
-        let (s, child_sharp) = refine_stencil(parent, sharp, &child);
+        let smooth = self.triangles == TriangleRule::Smooth;
+        let (s, child_sharp) = refine_stencil(parent, sharp, &child, smooth);
+        // Child face c is the child of parent corner c.
+        let holes = self.holes.last().expect("level 0");
+        let child_holes = if holes.is_empty() {
+            Vec::new()
+        } else {
+            (0..parent.num_faces())
+                .flat_map(|f| std::iter::repeat_n(holes[f], parent.face_vertices(f).len()))
+                .collect()
+        };
         self.levels.push(child);
         self.sharpness.push(child_sharp);
         self.stencils.push(s);
+        self.holes.push(child_holes);
+    }
+
+    /// Whether face `f` of level `k` is a hole.
+    pub fn is_hole(&self, k: usize, f: usize) -> bool {
+        self.holes[k].get(f).copied().unwrap_or(false)
     }
 
     /// Index of the finest level.
@@ -173,13 +267,49 @@ impl Hierarchy {
         Ok(out)
     }
 
-    /// The finest level as a mesh with the given positions.
+    /// Level `k` as a mesh with the given positions, its hole faces left out.
     pub fn mesh(&self, k: usize, positions: Vec<crate::math::Point3>) -> PolyMesh {
         let l = &self.levels[k];
+        if self.holes[k].is_empty() {
+            return PolyMesh {
+                positions,
+                face_offsets: l.face_offsets.clone(),
+                face_vertices: l.face_verts.clone(),
+            };
+        }
+        let mut face_offsets = vec![0];
+        let mut face_vertices = Vec::new();
+        for f in (0..l.num_faces()).filter(|&f| !self.holes[k][f]) {
+            face_vertices.extend_from_slice(l.face_vertices(f));
+            face_offsets.push(face_vertices.len() as u32);
+        }
         PolyMesh {
             positions,
-            face_offsets: l.face_offsets.clone(),
-            face_vertices: l.face_verts.clone(),
+            face_offsets,
+            face_vertices,
+        }
+    }
+}
+
+/// Marks as holes the faces around each boundary vertex with a boundary edge
+/// the user did not tag infinitely sharp (OpenSubdiv 3.6, `Far::
+/// TopologyRefinerFactoryBase::prepareComponentTagsAndSharpness` for
+/// `VTX_BOUNDARY_NONE`).
+fn boundary_holes(level: &Level, creases: &[(u32, u32, Real)], holes: &mut [bool]) {
+    let tagged: std::collections::HashSet<usize> = creases
+        .iter()
+        .filter(|c| c.2 as f32 as Real >= SHARPNESS_INFINITE)
+        .filter_map(|&(i, j, _)| crate::topology::find_edge(level, i, j))
+        .collect();
+    for v in 0..level.num_vertices {
+        let open = level
+            .vertex_edges(v)
+            .iter()
+            .any(|&e| level.is_boundary_edge(e as usize) && !tagged.contains(&(e as usize)));
+        if open {
+            for &f in level.vertex_faces(v) {
+                holes[f as usize] = true;
+            }
         }
     }
 }

@@ -6,5 +6,7 @@ mod sharpness;
 mod union_find;
 
 pub use level::{Level, NONE, VertexRing, face_of_corner};
-pub use sharpness::{SHARPNESS_INFINITE, Sharpness, VertexRule, decrement, find_edge};
+pub use sharpness::{
+    CreaseMethod, SHARPNESS_INFINITE, Sharpness, VertexRule, decrement, find_edge,
+};
 pub use union_find::UnionFind;

@@ -4,7 +4,9 @@
 //! character animation", §3) as implemented by OpenSubdiv's `Sdc` with the
 //! uniform crease method: a sharpness `s ≥ 10` is infinite; otherwise each
 //! level decrements it by one (`max(0, s − 1)`). Boundary edges are infinitely
-//! sharp.
+//! sharp. The Chaikin method (OpenSubdiv's `CREASE_CHAIKIN`, after Chaikin's
+//! curve scheme applied to sharpness values along a crease) decays each half
+//! of an edge towards the mean of the other semi-sharp edges at its end.
 
 use crate::error::{Error, Result};
 use crate::math::Real;
@@ -14,6 +16,31 @@ use super::Level;
 /// Sharpness at or above which a crease never smooths out.
 pub const SHARPNESS_INFINITE: Real = 10.0;
 
+/// How edge sharpness decays from one level to the next.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CreaseMethod {
+    /// Each half of an edge gets `max(0, s − 1)` (DeRose et al. 1998). The default.
+    #[default]
+    Uniform,
+    /// The half of edge `e` at vertex `v` gets `¾ s_e + ¼ mean(others) − 1`
+    /// (at least 0), the mean taken over the other semi-sharp edges at `v`;
+    /// `s_e − 1` when there are none. Vertex sharpness decays uniformly.
+    Chaikin,
+}
+
+impl std::str::FromStr for CreaseMethod {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "uniform" => Ok(CreaseMethod::Uniform),
+            "chaikin" => Ok(CreaseMethod::Chaikin),
+            _ => Err(Error::Input(format!(
+                "unknown crease method '{s}': expected uniform or chaikin"
+            ))),
+        }
+    }
+}
+
 /// Per-edge and per-vertex sharpness of one level.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Sharpness {
@@ -21,6 +48,8 @@ pub struct Sharpness {
     pub edge: Vec<Real>,
     /// One value per vertex (0 = smooth; infinite = corner).
     pub vertex: Vec<Real>,
+    /// How the edge values decay.
+    pub method: CreaseMethod,
 }
 
 /// The rule a vertex is refined with, from its number of sharp incident edges
@@ -63,12 +92,15 @@ impl VertexRule {
 
 impl Sharpness {
     /// Level-0 sharpness: user creases `(i, j, s)` (vertex pairs, 0-based),
-    /// boundary edges infinite, and — for the edge-and-corner boundary rule —
-    /// boundary vertices with a single face infinitely sharp (corners).
+    /// user vertex sharpness `(v, s)`, boundary edges infinite, and — for the
+    /// edge-and-corner boundary rule (`corners`) — boundary vertices with a
+    /// single face infinitely sharp (corners).
     pub fn initial(
         level: &Level,
         creases: &[(u32, u32, Real)],
+        vertex_sharpness: &[(u32, Real)],
         corners: bool,
+        method: CreaseMethod,
     ) -> Result<Sharpness> {
         let mut edge = vec![0.0; level.num_edges()];
         for (k, &(i, j, s)) in creases.iter().enumerate() {
@@ -91,7 +123,7 @@ impl Sharpness {
                 *s = SHARPNESS_INFINITE;
             }
         }
-        let vertex = (0..level.num_vertices)
+        let mut vertex: Vec<Real> = (0..level.num_vertices)
             .map(|v| {
                 if corners && level.vertex_faces(v).len() == 1 {
                     SHARPNESS_INFINITE
@@ -100,7 +132,79 @@ impl Sharpness {
                 }
             })
             .collect();
-        Ok(Sharpness { edge, vertex })
+        for (k, &(v, s)) in vertex_sharpness.iter().enumerate() {
+            if s.is_nan() || s < 0.0 {
+                return Err(Error::Input(format!(
+                    "vertex sharpness {k} (vertex {v}) is {s}; sharpness must be ≥ 0"
+                )));
+            }
+            let slot = vertex.get_mut(v as usize).ok_or_else(|| {
+                Error::Input(format!(
+                    "vertex sharpness {k}: vertex {v} is not in the mesh ({} vertices)",
+                    level.num_vertices
+                ))
+            })?;
+            *slot = slot.max((s as f32 as Real).min(SHARPNESS_INFINITE));
+        }
+        Ok(Sharpness {
+            edge,
+            vertex,
+            method,
+        })
+    }
+
+    /// The sharpness of the two halves of every edge after one level: entry
+    /// `2e` is the half at `edge_verts[e][0]`, `2e + 1` the one at
+    /// `edge_verts[e][1]` (the order of [`refine_topology`]'s child edges).
+    ///
+    /// Uniform: `max(0, s − 1)`. Chaikin (OpenSubdiv's `Sdc::Crease::
+    /// SubdivideEdgeSharpnessAtVertex`): for a semi-sharp edge `e` at a vertex
+    /// `v` with `k ≥ 2` semi-sharp edges (sum `Σ`), `¾ s_e + ¼ (Σ − s_e) /
+    /// (k − 1) − 1`, at least 0; `s_e − 1` when `e` is the only one.
+    ///
+    /// [`refine_topology`]: crate::subdivision::refine_topology
+    pub fn child_edges(&self, level: &Level) -> Vec<Real> {
+        let mut out = Vec::with_capacity(2 * self.edge.len());
+        for e in 0..self.edge.len() {
+            for v in level.edge_verts[e] {
+                out.push(self.half_at(level, e, v));
+            }
+        }
+        out
+    }
+
+    /// The child sharpness of the half of edge `e` at its end `v`.
+    fn half_at(&self, level: &Level, e: usize, v: u32) -> Real {
+        let s = self.edge[e];
+        let semi = |s: Real| s > 0.0 && s < SHARPNESS_INFINITE;
+        if self.method == CreaseMethod::Uniform || !semi(s) {
+            return decrement(s);
+        }
+        let (mut sum, mut k) = (0.0, 0usize);
+        for &g in level.vertex_edges(v as usize) {
+            let t = self.edge[g as usize];
+            if semi(t) {
+                sum += t;
+                k += 1;
+            }
+        }
+        if k < 2 {
+            return decrement(s);
+        }
+        (0.75 * s + 0.25 * (sum - s) / (k - 1) as Real - 1.0).max(0.0)
+    }
+
+    /// The child sharpness of the half at `v` of each edge of `v`, in the
+    /// order of `level.vertex_edges(v)`.
+    pub fn child_edges_at<'a>(
+        &'a self,
+        level: &'a Level,
+        v: usize,
+    ) -> impl Iterator<Item = Real> + 'a {
+        level
+            .vertex_edges(v)
+            .iter()
+            .map(move |&e| self.half_at(level, e as usize, v as u32))
     }
 
     /// The rule of vertex `v` at this level.
@@ -111,15 +215,9 @@ impl Sharpness {
         )
     }
 
-    /// The rule vertex `v` will have after one more level (sharpness decremented).
+    /// The rule vertex `v` will have after one more level.
     pub fn child_rule(&self, level: &Level, v: usize) -> VertexRule {
-        VertexRule::from_sharpness(
-            decrement(self.vertex[v]),
-            level
-                .vertex_edges(v)
-                .iter()
-                .map(|&e| decrement(self.edge[e as usize])),
-        )
+        VertexRule::from_sharpness(decrement(self.vertex[v]), self.child_edges_at(level, v))
     }
 
     /// True when any edge or vertex has a finite, non-zero sharpness.

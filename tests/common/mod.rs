@@ -332,6 +332,7 @@ pub fn refiner(mesh: &PolyMesh, boundary: BoundaryRule, creases: &[(u32, u32, f6
         &RefineOptions {
             boundary,
             creases: creases.to_vec(),
+            ..Default::default()
         },
     )
     .unwrap_or_else(|e| panic!("refiner: {e}"))
