@@ -92,10 +92,9 @@ impl RefineArgs {
             options = tags.apply(options);
         }
         if let Some(path) = &self.creases {
-            let tags = read_tags(path).map_err(|e| about_file(e, path))?;
-            options.creases.extend(tags.creases);
-            options.corners.extend(tags.corners);
-            options.holes.extend(tags.holes);
+            read_tags(path)
+                .map_err(|e| about_file(e, path))?
+                .add_to(&mut options);
         }
         if let Some(b) = self.boundary {
             options.boundary = b.rule();

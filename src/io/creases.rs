@@ -23,16 +23,11 @@ pub struct SubdivisionTags {
 }
 
 impl SubdivisionTags {
-    /// Appends `other`'s tags.
-    pub fn extend(&mut self, other: SubdivisionTags) {
-        self.creases.extend(other.creases);
-        self.corners.extend(other.corners);
-        self.holes.extend(other.holes);
-    }
-
-    /// True when there is no tag.
-    pub fn is_empty(&self) -> bool {
-        self.creases.is_empty() && self.corners.is_empty() && self.holes.is_empty()
+    /// Adds these tags to `options`.
+    pub fn add_to(self, options: &mut RefineOptions) {
+        options.creases.extend(self.creases);
+        options.corners.extend(self.corners);
+        options.holes.extend(self.holes);
     }
 }
 
@@ -55,9 +50,7 @@ pub struct ObjTags {
 impl ObjTags {
     /// `base` with these tags added and the scheme options they set.
     pub fn apply(self, mut base: RefineOptions) -> RefineOptions {
-        base.creases.extend(self.tags.creases);
-        base.corners.extend(self.tags.corners);
-        base.holes.extend(self.tags.holes);
+        self.tags.add_to(&mut base);
         if let Some(b) = self.boundary {
             base.boundary = b;
         }
