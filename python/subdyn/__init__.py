@@ -198,8 +198,10 @@ def subdivide(vertices: Any, faces: Faces, levels: int, creases: Any = None,
               quads: bool = False) -> Tuple[np.ndarray, List[np.ndarray]]:
     """Uniform Catmull-Clark refinement to ``levels`` (0 to 8), as ``subdyn
     subdivide``. ``creases`` is an (m, 3) array of rows ``(i, j, sharpness)``
-    (sharpness >= 10 is infinitely sharp); ``boundary`` "edge-and-corner" or
-    "edge-only". With ``limit`` the vertices lie on the limit surface and the
+    (sharpness >= 10 is infinitely sharp); ``boundary`` "edge-and-corner",
+    "edge-only" or "none" (the faces at untagged boundary vertices become
+    holes and are left out). Vertex sharpness, hole faces, the Chaikin crease
+    method and smooth triangles are on the command line only for now. With ``limit`` the vertices lie on the limit surface and the
     faces are triangles unless ``quads``. Returns ``(vertices, faces)``."""
     cr = None if creases is None else np.ascontiguousarray(creases, dtype=np.float64)
     v, fv, fo = _subdyn.subdivide(*_mesh_args(vertices, faces), int(levels), cr, boundary,

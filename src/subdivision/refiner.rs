@@ -35,7 +35,7 @@ pub enum TriangleRule {
     #[default]
     Catmark,
     /// Edges of a triangle weight its face point 0.47 instead of ¼
-    /// (OpenSubdiv's `TRI_SUB_SMOOTH`), which rounds meshes of triangles better.
+    /// (OpenSubdiv's `TRI_SUB_SMOOTH`, its option for smoother surfaces over triangles).
     Smooth,
 }
 
