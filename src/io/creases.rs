@@ -127,11 +127,7 @@ pub fn read_tags(path: impl AsRef<Path>) -> Result<SubdivisionTags> {
     Ok(tags)
 }
 
-/// Parses the `t` lines of OBJ text (OpenSubdiv's syntax `t name ni/nf/ns
-/// ints… floats… strings…`): `crease` (a chain of vertices, one sharpness or
-/// one per edge), `corner` (vertices, one sharpness or one per vertex),
-/// `hole` (faces), `interpolateboundary`, `creasemethod`, `smoothtriangles`.
-/// Indices are 0-based, as OpenSubdiv writes them.
+/// The `t` lines of OBJ text ([`read_obj_tags`]).
 pub(crate) fn parse_obj_tags(bytes: &[u8], path: &Path) -> Result<ObjTags> {
     let mut out = ObjTags::default();
     for item in content_lines(bytes, path) {
@@ -233,8 +229,12 @@ pub(crate) fn parse_obj_tags(bytes: &[u8], path: &Path) -> Result<ObjTags> {
     Ok(out)
 }
 
-/// Reads the tags of an OBJ file ([`parse_obj_tags`]); a file without `t`
-/// lines has none.
+/// Reads the `t` lines of an OBJ file, in OpenSubdiv's syntax `t name
+/// ni/nf/ns ints… floats… strings…`: `crease` (a chain of vertices, one
+/// sharpness or one per edge), `corner` (vertices, one sharpness or one per
+/// vertex), `hole` (faces), `interpolateboundary`, `creasemethod`,
+/// `smoothtriangles`; other tags are listed in [`ObjTags::ignored`]. Indices
+/// are 0-based, as OpenSubdiv writes them. A file without `t` lines has none.
 pub fn read_obj_tags(path: impl AsRef<Path>) -> Result<ObjTags> {
     let path = path.as_ref();
     parse_obj_tags(&read_input(path)?, path)

@@ -4,7 +4,8 @@
 //! Read: `v x y z [w] [r g b]` (columns past `z` ignored), `vn`, and `f` with
 //! `a`, `a/b`, `a//c` or `a/b/c` corners; negative indices count back from the
 //! last vertex defined so far. Groups and objects (`g`, `o`) merge into one
-//! mesh; every other statement (`vt`, `s`, `usemtl`, `l`, …) is skipped.
+//! mesh; every other statement (`vt`, `s`, `usemtl`, `l`, …) is skipped (OpenSubdiv's
+//! `t` tag lines are read by [`read_obj_tags`](super::read_obj_tags)).
 
 use std::io::Write;
 use std::path::Path;
