@@ -695,7 +695,10 @@ fn bench_subdivide_prints_json_last_line() {
     assert_eq!(json["vertices"], 256);
     assert_eq!(json["faces"], 256);
     assert!(json["max_abs_diff"].as_f64().unwrap() < 1e-12);
-    assert_eq!(json["opensubdiv_reference"]["stencil_build_s"], 1.4);
+    assert!(
+        json.get("opensubdiv_reference").is_none(),
+        "no stale anchor figures"
+    );
     assert!(out.contains("stencil apply"), "human-readable table: {out}");
     assert!(files(dir.path()).is_empty());
 }
