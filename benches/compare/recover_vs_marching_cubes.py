@@ -91,6 +91,7 @@ import json
 import math
 import os
 import platform
+import shlex
 import statistics
 import subprocess
 import sys
@@ -434,9 +435,10 @@ def marching_cubes(side: dict, base: Path, out: Path, smooth: bool) -> dict:
 
 
 def sigma_args(args, voxel: float) -> list:
-    """`--sigma` for subdyn recover when --sigma-voxels is given (σ in voxels × the smallest
-    spacing), else nothing (subdyn's default)."""
-    return [] if args.sigma_voxels is None else ["--sigma", repr(args.sigma_voxels * voxel)]
+    """The options added to every subdyn recover: `--sigma` when --sigma-voxels is given (σ in
+    voxels × the smallest spacing), then --subdyn-args (nothing by default: subdyn's defaults)."""
+    sigma = [] if args.sigma_voxels is None else ["--sigma", repr(args.sigma_voxels * voxel)]
+    return sigma + shlex.split(args.subdyn_args)
 
 
 def subdyn_recover(subdyn: Path, base: Path, iso: float, work: Path, extra=()) -> dict:
@@ -1114,6 +1116,9 @@ def main() -> None:
     ap.add_argument("--no-mni", action="store_true", help="skip the MNI templates")
     ap.add_argument("--sigma-voxels", type=float, default=None,
                     help="pass --sigma (this many voxels of the smallest spacing) to every subdyn recover")
+    ap.add_argument("--subdyn-args", default="",
+                    help="more options for every subdyn recover, one shell-quoted string "
+                         "(e.g. \"--tol 0.25\"), to try a setting on the whole bench")
     ap.add_argument("--upgrade", action="store_true", help="reinstall the venv packages")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)

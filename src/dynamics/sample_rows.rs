@@ -1,16 +1,18 @@
-//! The force samples of the dynamics as first-derivative rows over the
-//! control points, built patch by patch.
+//! The force samples of the dynamics as tangent rows over the control
+//! points, built patch by patch.
 //!
 //! Image and spring forces on the limit surface need, at every sample, the
-//! position `x = J p` and the tangents `x_u = J_u p`, `x_v = J_v p` (their
-//! cross product is the normal and the area element; Qin et al. 1998,
-//! eq. 15 and §5), and nothing of second order since `K` and `D` are
-//! assembled patch by patch ([`super::patch_stiffness_matrix`]). The same
-//! points as [`super::patch_samples`] (an `order × order` Gauss-Legendre rule
-//! on every patch), but each row is carried to the control points
-//! (`J = J_L S`, `S` the level-`L` refinement) as soon as it is evaluated,
-//! so only the three composed tables are ever held — not six level-`L`
-//! tables next to their composition, nor every point's dense stencil.
+//! tangents `x_u = J_u p`, `x_v = J_v p` (their cross product is the normal
+//! and the area element; Qin et al. 1998, eq. 15 and §5), besides the
+//! position `x = J p`, whose rows the springs' own assembly makes
+//! ([`PatchAssembly::rows_at`](crate::forces::PatchAssembly::rows_at)), and
+//! nothing of second order since `K` and `D` are assembled patch by patch
+//! ([`super::patch_stiffness_matrix`]). The same points as
+//! [`super::patch_samples`] (an `order × order` Gauss-Legendre rule on every
+//! patch), but each row is carried to the control points (`J_u = J_{u,L} S`,
+//! `S` the level-`L` refinement) as soon as it is evaluated, so only the two
+//! composed tables are ever held — not the level-`L` tables next to their
+//! composition, nor every point's dense stencil.
 
 use rayon::prelude::*;
 
@@ -21,11 +23,9 @@ use crate::limit::PatchTable;
 use crate::math::Real;
 use crate::stencil::{RowBuilder, StencilTable};
 
-/// Rows `J, J_u, J_v` of the force samples over the control points.
+/// Rows `J_u, J_v` of the force samples over the control points.
 #[derive(Clone, Debug)]
 pub struct SampleRows {
-    /// Positions: `x = J p`.
-    pub j: StencilTable,
     /// First derivatives in the base faces' `u`.
     pub ju: StencilTable,
     /// First derivatives in `v`.
@@ -41,10 +41,11 @@ pub struct SampleRows {
 const PATCHES_PER_TASK: usize = 64;
 
 /// One task's rows: per quantity the row lengths, columns and weights.
-type Part = ([(Vec<usize>, Vec<u32>, Vec<Real>); 3], Vec<Real>, Vec<u32>);
+type Part = ([(Vec<usize>, Vec<u32>, Vec<Real>); 2], Vec<Real>, Vec<u32>);
 
 /// `order × order` Gauss-Legendre points on every patch of `table` (the
-/// points of [`super::patch_samples`]), as rows over the control points.
+/// points of [`super::patch_samples`]), their tangent rows over the control
+/// points.
 pub fn patch_sample_rows(table: &PatchTable, order: usize) -> Result<SampleRows> {
     if order == 0 || order > 16 {
         return Err(Error::Input(format!(
@@ -67,7 +68,7 @@ pub fn patch_sample_rows(table: &PatchTable, order: usize) -> Result<SampleRows>
                     rows_to_base(&mut st.weights, inv);
                     for (q, (lens, idx, wts)) in part.0.iter_mut().enumerate() {
                         b.clear();
-                        for (&c, &x) in st.cols.iter().zip(&st.weights[q]) {
+                        for (&c, &x) in st.cols.iter().zip(&st.weights[q + 1]) {
                             if x != 0.0 {
                                 let (ic, iw) = s.row(c as usize);
                                 for (&ci, &y) in ic.iter().zip(iw) {
@@ -92,7 +93,7 @@ pub fn patch_sample_rows(table: &PatchTable, order: usize) -> Result<SampleRows>
     let rows = parts.iter().map(|p| p.1.len()).sum();
     let mut weights = Vec::with_capacity(rows);
     let mut patch = Vec::with_capacity(rows);
-    let mut tables: [StencilTable; 3] = std::array::from_fn(|q| {
+    let mut tables: [StencilTable; 2] = std::array::from_fn(|q| {
         let entries = parts.iter().map(|p| p.0[q].1.len()).sum();
         StencilTable::with_capacity(s.num_cols, rows, entries)
     });
@@ -110,9 +111,8 @@ pub fn patch_sample_rows(table: &PatchTable, order: usize) -> Result<SampleRows>
         weights.extend_from_slice(&w);
         patch.extend_from_slice(&f);
     }
-    let [j, ju, jv] = tables;
+    let [ju, jv] = tables;
     Ok(SampleRows {
-        j,
         ju,
         jv,
         weights,

@@ -146,9 +146,11 @@ pub fn recover_shape(
         };
         let point_k = vec![params.points_weight / points.len().max(1) as Real; points.len()];
         // The two-sided forces' points: every `stride`-th iso-surface point,
-        // at most as many as the samples.
+        // at most a quarter as many as the samples (their search is most of
+        // a step's time; a part the surface misses still holds one point
+        // per few voxels of its surface).
         let far_from: Vec<Point3> = if params.two_sided_weight > 0.0 {
-            let stride = boundary.len().div_ceil(weights.len().max(1)).max(1);
+            let stride = (4 * boundary.len()).div_ceil(weights.len().max(1)).max(1);
             boundary.iter().step_by(stride).copied().collect()
         } else {
             Vec::new()
@@ -162,6 +164,7 @@ pub fn recover_shape(
         let mut p = mesh.positions.clone();
         let mut p_before = p.clone();
         let mut energy: Vec<Real> = Vec::new();
+        let mut nearest = Vec::new();
         let (mut steps, mut cg_iterations, mut still) = (0, 0, false);
         let (offsets, unresolved, search, outside_box, unmatched, off) = loop {
             let search = search_of(&p);
@@ -213,7 +216,8 @@ pub fn recover_shape(
             if !points.is_empty() || !far_from.is_empty() {
                 engine.set_positions(&p)?;
             }
-            let (far, far_closest) = far_points(&engine, &xs, &us, &vs, &at, &far_from, reach)?;
+            let (far, far_closest) =
+                far_points(&engine, &xs, &us, &vs, &at, &far_from, reach, &mut nearest)?;
             let far_k = vec![two_sided_k; far.len()];
             let mut springs = system.assembly.data_springs(
                 engine.table(),
@@ -516,6 +520,13 @@ fn gauss_points(table: &PatchTable, order: usize) -> Vec<(usize, [Real; 2])> {
 /// groove that the image springs along its normals see (a sulcus, a gap
 /// between legs), and a coarse level cannot follow a deep one; outside, it
 /// has missed a part (a horn tip, a leg the cage lost).
+///
+/// `nearest` carries every point's nearest sample from one step to the
+/// next of a level (the same samples, moved; empty at a level's first
+/// step): a point still within `reach` of it has its nearest sample within
+/// reach too, so is left out without a search. The result is the same as
+/// searching every point; most points stay near the surface between steps,
+/// so most searches are saved.
 fn far_points(
     engine: &ClosestPointEngine,
     xs: &[Point3],
@@ -524,8 +535,25 @@ fn far_points(
     at: &[(usize, [Real; 2])],
     from: &[Point3],
     reach: Real,
+    nearest: &mut Vec<u32>,
 ) -> Result<(Vec<Point3>, Vec<ClosestPoint>)> {
     if from.is_empty() || xs.is_empty() {
+        return Ok((Vec::new(), Vec::new()));
+    }
+    let reach2 = reach * reach;
+    if nearest.len() != from.len() {
+        nearest.clear();
+        nearest.resize(from.len(), u32::MAX);
+    }
+    let near = |b: &Point3, i: u32| {
+        xs.get(i as usize)
+            .is_some_and(|x| (b - x).norm_squared() <= reach2)
+    };
+    if from
+        .par_iter()
+        .zip(nearest.par_iter())
+        .all(|(b, &i)| near(b, i))
+    {
         return Ok((Vec::new(), Vec::new()));
     }
     let tree = ImmutableKdTree::<Real, 3>::new_from_slice(
@@ -533,11 +561,16 @@ fn far_points(
     );
     let (candidates, starts): (Vec<Point3>, Vec<(u32, [Real; 2])>) = from
         .par_iter()
-        .filter_map(|b| {
+        .zip(nearest.par_iter_mut())
+        .filter_map(|(b, cached)| {
+            if near(b, *cached) {
+                return None;
+            }
             let nn = tree.nearest_one::<SquaredEuclidean>(&[b.x, b.y, b.z]);
+            *cached = nn.item as u32;
             let i = nn.item as usize;
             let outward = (b - xs[i]).dot(&us[i].coords.cross(&vs[i].coords)) > 0.0;
-            (nn.distance > reach * reach && outward).then(|| {
+            (nn.distance > reach2 && outward).then(|| {
                 let (f, st) = at[i];
                 (*b, (f as u32, st))
             })
