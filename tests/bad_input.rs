@@ -370,6 +370,47 @@ fn work_over_the_memory_budget_is_refused_with_the_estimate() {
         &["sigma", "far beyond the volume"],
         &inputs,
     );
+    // A fit's and a recovery's levels are estimated before they are built
+    // (about 100 kB per control face; these take 500–1,000 faces).
+    refused(
+        d,
+        &[
+            "--max-memory",
+            "1M",
+            "recover",
+            "ball.raw",
+            "-o",
+            "b.obj",
+            "--report",
+            "b.json",
+        ],
+        &["ball.raw", "level 0 of", "control faces", "--max-memory"],
+        &inputs,
+    );
+    let points: String = (0..2000)
+        .map(|i| {
+            // A Fibonacci sphere: 2,000 points, evenly spread.
+            let z = 1.0 - (2 * i + 1) as f64 / 2000.0;
+            let (r, t) = ((1.0 - z * z).sqrt(), i as f64 * 2.399_963_229_728_653);
+            format!("{} {} {z}\n", r * t.cos(), r * t.sin())
+        })
+        .collect();
+    std::fs::write(d.join("sphere.xyz"), points).unwrap();
+    refused(
+        d,
+        &[
+            "--max-memory",
+            "1M",
+            "fit",
+            "sphere.xyz",
+            "-o",
+            "s.obj",
+            "--limit-out",
+            "s.ply",
+        ],
+        &["sphere.xyz", "level 0 of", "control faces", "--max-memory"],
+        &["ball.json", "ball.raw", "cube.obj", "sphere.xyz"],
+    );
 }
 
 #[test]

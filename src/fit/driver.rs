@@ -46,7 +46,7 @@ use super::levels::{fitted_worse, split_within, stop_after_level};
 use super::quality::{SelfIntersections, assess};
 use super::refine_marks::{face_residuals, faces_above_noise, faces_off_data};
 use super::sampling::{shuffled_order, surface_samples, trimmed_rms};
-use super::system::LevelSystem;
+use super::system::{LevelSystem, check_level_memory};
 use super::{ErrorStats, FitParams, FitReport, LevelReport, Refinement, ToleranceStat};
 
 /// Taubin steps on the control points of the faces an untangling round
@@ -166,6 +166,7 @@ pub fn fit_screened_cloud(
     let (converged, stop_reason) = loop {
         let level = levels.len();
         let level_start = Instant::now();
+        check_level_memory(level, mesh.num_faces())?;
         let refiner = Refiner::new(&mesh, &RefineOptions::default())?;
         let mut engine = ClosestPointEngine::with_quadtrees(
             &refiner,

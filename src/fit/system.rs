@@ -20,7 +20,26 @@ use crate::error::Result;
 use crate::forces::{PatchAssembly, SpringSystem};
 use crate::limit::PatchTable;
 use crate::math::{Point3, Real};
+use crate::memory::{bytes_of, check_memory};
 use crate::stencil::StencilTable;
+
+/// About the most bytes one level of the fit or of the recovery holds per
+/// control face: its patches, samples, springs, this system, the closest-point
+/// engine and the quality tessellations. Peak RSS ÷ the last level's control
+/// faces was 73–97 kB on the fit's corpus (spot, sphere, bracket, chair,
+/// dragon scans) and on the MNI T1 brain's recovery; rounded up.
+pub(crate) const LEVEL_BYTES_PER_FACE: u64 = 100_000;
+
+/// `Ok` when a level of `faces` control faces fits the memory budget
+/// ([`crate::memory`]), else the error naming the estimate: checked before a
+/// level is built, so a run that would outgrow memory (a huge cloud allowed
+/// many control points, a fine uniform level) stops with one line instead.
+pub(crate) fn check_level_memory(level: usize, faces: usize) -> Result<()> {
+    check_memory(
+        &format!("level {level} of {faces} control faces"),
+        bytes_of(faces as u64, LEVEL_BYTES_PER_FACE),
+    )
+}
 
 /// `K`, `D` and `M` of one control mesh in the pattern of its
 /// [`PatchAssembly`], and the sums the step needs.

@@ -26,7 +26,7 @@ use crate::error::{Error, Result};
 use crate::fit::ErrorStats;
 use crate::fit::Refinement;
 use crate::fit::levels::{fitted_worse, split_within, stop_after_level};
-use crate::fit::system::LevelSystem;
+use crate::fit::system::{LevelSystem, check_level_memory};
 use crate::forces::{
     ImageField, Offset, RowSprings, SpringSystem, inflation_force, spread_point_springs,
 };
@@ -87,6 +87,7 @@ pub fn recover_shape(
     let (converged, stop_reason) = loop {
         let level = levels.len();
         let level_start = Instant::now();
+        check_level_memory(level, mesh.num_faces())?;
         let refiner = Refiner::new(&mesh, &RefineOptions::default())?;
         if (0..refiner.level.num_edges()).any(|e| refiner.level.is_boundary_edge(e)) {
             return Err(Error::Topology(
