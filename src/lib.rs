@@ -15,7 +15,7 @@
 //! # let _ = io::MeshFormat::Obj;
 //! ```
 //!
-//! Modules: [`math`] (scalar and point types), [`error`], [`memory`] (the memory budget), [`mesh`] (polygon
+//! Modules: [`math`] (scalar and point types), [`error`], [`memory`] (the memory budget), [`allocator`] (the binary's one-line out-of-memory exit), [`mesh`] (polygon
 //! meshes, point clouds), [`io`] (OBJ, PLY, OFF, XYZ), [`topology`] (edges,
 //! adjacency, tags), [`subdivision`] (Catmull-Clark refinement, B-spline curves), [`stencil`]
 //! (CSR stencil tables), [`limit`] (limit masks, exact evaluation, closest point),
@@ -26,6 +26,7 @@
 
 #![warn(missing_docs)]
 
+pub mod allocator;
 pub mod dynamics;
 pub mod error;
 pub mod examples;

@@ -6,6 +6,10 @@
 
 mod cli;
 
+/// An allocation the system refuses ends the run with one line (exit 1).
+#[global_allocator]
+static ALLOCATOR: subdyn::allocator::OneLineOutOfMemory = subdyn::allocator::OneLineOutOfMemory;
+
 fn main() -> std::process::ExitCode {
     cli::run()
 }

@@ -577,3 +577,67 @@ fn exact_limit_evaluation_refuses_huge_valences_and_polygons() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// An allocation the system refuses, past an estimate (the budget set far
+/// above an address-space limit of 400 MB): one line and exit 1, not Rust's
+/// two-line abort, and nothing left in the directory.
+#[test]
+fn a_refused_allocation_ends_the_run_with_one_line() {
+    use std::os::unix::process::CommandExt;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    cube(d);
+    assert!(
+        run_subdyn(
+            d,
+            &[
+                "subdivide",
+                "cube.obj",
+                "-l",
+                "4",
+                "-o",
+                "c4.obj",
+                "--quiet"
+            ]
+        )
+        .status
+        .success()
+    );
+    std::fs::remove_file(d.join("cube.obj")).unwrap();
+    let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_subdyn"));
+    command
+        .args([
+            "--max-memory",
+            "100G",
+            "subdivide",
+            "c4.obj",
+            "-l",
+            "7",
+            "-o",
+            "big.obj",
+        ])
+        .current_dir(d);
+    // SAFETY: setrlimit(2) only, between fork and exec.
+    unsafe {
+        command.pre_exec(|| {
+            let limit = libc::rlimit {
+                rlim_cur: 400 << 20,
+                rlim_max: 400 << 20,
+            };
+            if libc::setrlimit(libc::RLIMIT_AS, &limit) == 0 {
+                Ok(())
+            } else {
+                Err(std::io::Error::last_os_error())
+            }
+        });
+    }
+    let start = Instant::now();
+    let out = command.output().unwrap();
+    assert!(start.elapsed() < FAST);
+    assert_clean_failure(
+        d,
+        &out,
+        &["out of memory", "nothing was written"],
+        &["c4.obj"],
+    );
+}

@@ -150,13 +150,13 @@ pub fn recover_shape(
         // at most a quarter as many as the samples (their search is most of
         // a step's time; a part the surface misses still holds one point
         // per few voxels of its surface).
-        let far_from: Vec<Point3> = if params.two_sided_weight > 0.0 {
+        let mut far_from = Candidates::new(if params.two_sided_weight > 0.0 {
             let stride = (4 * boundary.len()).div_ceil(weights.len().max(1)).max(1);
             boundary.iter().step_by(stride).copied().collect()
         } else {
             Vec::new()
-        };
-        let two_sided_k = params.two_sided_weight / far_from.len().max(1) as Real;
+        });
+        let two_sided_k = params.two_sided_weight / far_from.points.len().max(1) as Real;
         let reach = params.two_sided_voxels * voxel;
         // User points pull a patch as wide as a level-0 control edge at
         // every level (each subdivision halves the edges).
@@ -165,7 +165,6 @@ pub fn recover_shape(
         let mut p = mesh.positions.clone();
         let mut p_before = p.clone();
         let mut energy: Vec<Real> = Vec::new();
-        let mut nearest = Vec::new();
         let (mut steps, mut cg_iterations, mut still) = (0, 0, false);
         let (offsets, unresolved, search, outside_box, unmatched, off) = loop {
             let search = search_of(&p);
@@ -214,11 +213,10 @@ pub fn recover_shape(
             }
             let targets: Vec<Point3> = found.iter().map(|f| f.0).collect();
             let kw: Vec<Real> = found.iter().map(|f| f.1 / total).collect();
-            if !points.is_empty() || !far_from.is_empty() {
+            if !points.is_empty() || !far_from.points.is_empty() {
                 engine.set_positions(&p)?;
             }
-            let (far, far_closest) =
-                far_points(&engine, &xs, &us, &vs, &at, &far_from, reach, &mut nearest)?;
+            let (far, far_closest) = far_points(&engine, &xs, &us, &vs, &at, &mut far_from, reach)?;
             let far_k = vec![two_sided_k; far.len()];
             let mut springs = system.assembly.data_springs(
                 engine.table(),
@@ -275,7 +273,7 @@ pub fn recover_shape(
                 let unresolved = 1.0 - t.len() as Real / found.len() as Real;
                 let outside_box = beyond.iter().filter(|&&b| b > 1.0).count() as Real
                     / beyond.len().max(1) as Real;
-                let unmatched = far.len() as Real / far_from.len().max(1) as Real;
+                let unmatched = far.len() as Real / far_from.points.len().max(1) as Real;
                 // How far off the boundary each face is, for adaptive
                 // refinement: the far iso-surface points whose closest point
                 // it holds, and while the offsets' 95th percentile is above
@@ -336,7 +334,7 @@ pub fn recover_shape(
             unresolved,
             search_voxels: search,
             outside_box,
-            boundary_points: far_from.len(),
+            boundary_points: far_from.points.len(),
             unmatched,
         });
         // A finer level that follows the image worse than its parent on
@@ -512,6 +510,21 @@ fn gauss_points(table: &PatchTable, order: usize) -> Vec<(usize, [Real; 2])> {
         .collect()
 }
 
+/// The two-sided forces' candidates: iso-surface points, and each one's
+/// nearest sample carried from one step to the next of a level (the same
+/// samples, moved; `u32::MAX` before the first search).
+struct Candidates {
+    points: Vec<Point3>,
+    nearest: Vec<u32>,
+}
+
+impl Candidates {
+    fn new(points: Vec<Point3>) -> Candidates {
+        let nearest = vec![u32::MAX; points.len()];
+        Candidates { points, nearest }
+    }
+}
+
 /// The points of `from` outside the limit surface of `engine` (whose
 /// samples `xs`, with tangents `us`, `vs`, sit at `at`) and farther than
 /// `reach` from it, with their closest points: the two-sided forces'
@@ -522,37 +535,31 @@ fn gauss_points(table: &PatchTable, order: usize) -> Vec<(usize, [Real; 2])> {
 /// between legs), and a coarse level cannot follow a deep one; outside, it
 /// has missed a part (a horn tip, a leg the cage lost).
 ///
-/// `nearest` carries every point's nearest sample from one step to the
-/// next of a level (the same samples, moved; empty at a level's first
-/// step): a point still within `reach` of it has its nearest sample within
-/// reach too, so is left out without a search. The result is the same as
-/// searching every point; most points stay near the surface between steps,
-/// so most searches are saved.
+/// A point still within `reach` of its last nearest sample has its nearest
+/// sample within reach too, so is left out without a search. The result is
+/// the same as searching every point; most points stay near the surface
+/// between steps, so most searches are saved.
 fn far_points(
     engine: &ClosestPointEngine,
     xs: &[Point3],
     us: &[Point3],
     vs: &[Point3],
     at: &[(usize, [Real; 2])],
-    from: &[Point3],
+    from: &mut Candidates,
     reach: Real,
-    nearest: &mut Vec<u32>,
 ) -> Result<(Vec<Point3>, Vec<ClosestPoint>)> {
-    if from.is_empty() || xs.is_empty() {
+    if from.points.is_empty() || xs.is_empty() {
         return Ok((Vec::new(), Vec::new()));
     }
     let reach2 = reach * reach;
-    if nearest.len() != from.len() {
-        nearest.clear();
-        nearest.resize(from.len(), u32::MAX);
-    }
     let near = |b: &Point3, i: u32| {
         xs.get(i as usize)
             .is_some_and(|x| (b - x).norm_squared() <= reach2)
     };
     if from
+        .points
         .par_iter()
-        .zip(nearest.par_iter())
+        .zip(from.nearest.par_iter())
         .all(|(b, &i)| near(b, i))
     {
         return Ok((Vec::new(), Vec::new()));
@@ -561,8 +568,9 @@ fn far_points(
         &xs.iter().map(|x| [x.x, x.y, x.z]).collect::<Vec<_>>(),
     );
     let (candidates, starts): (Vec<Point3>, Vec<(u32, [Real; 2])>) = from
+        .points
         .par_iter()
-        .zip(nearest.par_iter_mut())
+        .zip(from.nearest.par_iter_mut())
         .filter_map(|(b, cached)| {
             if near(b, *cached) {
                 return None;

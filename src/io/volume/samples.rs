@@ -126,7 +126,7 @@ pub(crate) fn read_samples(
         crate::memory::bytes_of(count as u64, 4),
     )?;
     let mut out = Vec::new();
-    out.try_reserve_exact(count).map_err(|_| {
+    crate::allocator::try_reserve_exact(&mut out, count).map_err(|_| {
         Error::parse(
             path,
             0,

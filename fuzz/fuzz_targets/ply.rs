@@ -1,0 +1,20 @@
+//! The PLY reader, as a mesh and as a point cloud, from bytes; gzip
+//! streams also from a `.ply.gz` file.
+#![no_main]
+
+use std::path::Path;
+
+use libfuzzer_sys::fuzz_target;
+use subdyn::io::{MeshFormat, read_mesh_from_bytes, read_points_from_bytes};
+
+fuzz_target!(|data: &[u8]| {
+    subdyn_fuzz::init();
+    let name = Path::new("fuzz.ply");
+    let _ = read_mesh_from_bytes(data, MeshFormat::Ply, name);
+    let _ = read_points_from_bytes(data, MeshFormat::Ply, name);
+    // A gzip stream goes through the file reader's capped inflation.
+    if data.starts_with(&[0x1f, 0x8b]) {
+        let dir = subdyn_fuzz::scratch(&["fuzz.ply.gz"]);
+        let _ = subdyn::io::read_mesh(subdyn_fuzz::file(&dir, "fuzz.ply.gz", data));
+    }
+});
