@@ -55,7 +55,15 @@ fn a_torus_is_recovered_from_its_thresholded_component_with_edges() {
     let vol = sdf_volume([60, 60, 27], [1.0, 1.0, 1.5], sdf);
     let params = RecoverParams::default();
     let prepared = prepare_volume(&vol, &params).unwrap();
-    let cage = component_cage(&prepared.smoothed, prepared.inside_level, true, None, 12).unwrap();
+    let cage = component_cage(
+        &prepared.smoothed,
+        &prepared.smoothed,
+        prepared.inside_level,
+        true,
+        None,
+        12,
+    )
+    .unwrap();
     assert_eq!(cage.genus, 1);
     let out = recover_shape(
         &prepared,
@@ -103,7 +111,8 @@ fn a_rod_two_voxels_thick_is_kept_by_the_automatic_cage() {
             ..Default::default()
         };
         let prepared = prepare_volume(&vol, &params).unwrap();
-        let cage = component_cage(&prepared.smoothed, 0.5, true, None, 12).unwrap();
+        let cage =
+            component_cage(&prepared.smoothed, &prepared.smoothed, 0.5, true, None, 12).unwrap();
         assert!(cage.block >= 3, "block {}", cage.block);
         let out = recover_shape(
             &prepared,
@@ -158,7 +167,7 @@ fn a_part_missing_from_the_cage_grows_back_by_the_two_sided_forces() {
             ..Default::default()
         };
         let prepared = prepare_volume(&vol, &params).unwrap();
-        let boundary = component_cage(&prepared.smoothed, 0.5, true, None, 12)
+        let boundary = component_cage(&prepared.smoothed, &prepared.smoothed, 0.5, true, None, 12)
             .unwrap()
             .boundary;
         // The ball's cage: the rod is not in it.
@@ -213,7 +222,8 @@ fn adaptive_levels_keep_within_the_control_point_budget() {
             ..Default::default()
         };
         let prepared = prepare_volume(&vol, &params).unwrap();
-        let cage = component_cage(&prepared.smoothed, 0.5, true, None, 6).unwrap();
+        let cage =
+            component_cage(&prepared.smoothed, &prepared.smoothed, 0.5, true, None, 6).unwrap();
         let boundary = cage.boundary;
         let out = recover_shape(
             &prepared,
@@ -494,4 +504,63 @@ fn an_owned_volume_is_prepared_like_a_borrowed_one() {
         ..Default::default()
     };
     assert!(prepare_volume_owned(vol, &params).is_err());
+}
+
+/// Parts (issue 25 item 1): a body and a smaller ball apart from it (a
+/// hoof the threshold cut off, a bone fragment) each get a closed cage and
+/// both are recovered, as marching cubes keeps both; a seed in the body
+/// keeps the body alone; a speck under the part size is left out.
+#[test]
+fn every_part_of_the_object_is_recovered_unless_a_seed_picks_one() {
+    let (body, part, speck) = (
+        Point3::new(16.0, 20.0, 20.0),
+        Point3::new(34.0, 20.0, 20.0),
+        Point3::new(34.0, 32.0, 32.0),
+    );
+    let sdf = move |p: Point3| {
+        ((p - body).norm() - 9.0)
+            .min((p - part).norm() - 4.0)
+            .min((p - speck).norm() - 1.0)
+    };
+    let vol = sdf_volume([42, 40, 40], [1.0; 3], sdf);
+    let params = RecoverParams {
+        boundary: BoundaryModel::Iso { value: 0.5 },
+        ..Default::default()
+    };
+    let prepared = prepare_volume(&vol, &params).unwrap();
+    let cage = component_cage(&prepared.smoothed, &prepared.smoothed, 0.5, true, None, 12).unwrap();
+    assert_eq!((cage.components, cage.parts), (3, 2));
+    let out = recover_shape(
+        &prepared,
+        &cage.mesh,
+        &[],
+        &cage.boundary,
+        &params,
+        &mut |_, _, _| {},
+    )
+    .unwrap();
+    assert!(subdyn::fit::recover::poor_result(&out.report, &params).is_empty());
+    let topo = subdyn::fit::init::surface_topology(&out.control).unwrap();
+    assert_eq!((topo.components, topo.boundary_loops), (2, 0));
+    let (max, mean) = surface_error(&out.control, sdf);
+    assert!(mean < 0.3 && max < 1.0, "mean {mean} max {max}");
+    // Both parts are there: the limit surface reaches into the small ball.
+    let refiner = Refiner::new(&out.control, &RefineOptions::default()).unwrap();
+    let (tess, _) = tessellate(&refiner, &out.control.positions, 4).unwrap();
+    assert!(
+        tess.positions
+            .iter()
+            .any(|p| (p - part).norm() < 4.5 && p.x > 36.0)
+    );
+    let seeded = component_cage(
+        &prepared.smoothed,
+        &prepared.smoothed,
+        0.5,
+        true,
+        Some(body),
+        12,
+    )
+    .unwrap();
+    assert_eq!(seeded.parts, 1);
+    assert!(seeded.mesh.positions.iter().all(|p| p.x < 27.0));
 }

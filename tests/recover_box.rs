@@ -28,7 +28,7 @@ fn a_ball_cut_by_the_box_closes_on_the_box_face() {
     };
     let prepared = prepare_volume(&vol, &params).unwrap();
     assert_eq!(prepared.smoothed.dims(), [34, 34, 34]);
-    let cage = component_cage(&prepared.smoothed, 0.5, true, None, 12).unwrap();
+    let cage = component_cage(&prepared.smoothed, &prepared.smoothed, 0.5, true, None, 12).unwrap();
     let out = recover_shape(
         &prepared,
         &cage.mesh,

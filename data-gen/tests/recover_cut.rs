@@ -52,8 +52,15 @@ fn a_sphere_cut_by_the_box_is_recovered_closed_with_its_cap_on_the_box_face() {
         ..Default::default()
     };
     let prepared = prepare_volume_owned(volume, &params).expect("prepared");
-    let cage = component_cage(&prepared.smoothed, prepared.inside_level, true, None, 24)
-        .expect("a cage of the cut component");
+    let cage = component_cage(
+        &prepared.smoothed,
+        &prepared.smoothed,
+        prepared.inside_level,
+        true,
+        None,
+        24,
+    )
+    .expect("a cage of the cut component");
     let out = recover_shape(
         &prepared,
         &cage.mesh,

@@ -108,8 +108,16 @@ pub fn bench_recover(args: &BenchRecoverArgs) -> anyhow::Result<()> {
     let prepared = prepared?;
     progress.stage("initial model");
     let t = Instant::now();
-    let (cage, init_peak) =
-        stage_peak(|| component_cage(&prepared.smoothed, prepared.inside_level, true, None, 24));
+    let (cage, init_peak) = stage_peak(|| {
+        component_cage(
+            &prepared.smoothed,
+            &prepared.smoothed,
+            prepared.inside_level,
+            true,
+            None,
+            24,
+        )
+    });
     let cage = cage?;
     let init_s = t.elapsed().as_secs_f64();
     let mut on_step = |level: usize, step: usize, _e: f64| {

@@ -42,11 +42,13 @@ pub struct RecoverArgs {
     pub output: PathBuf,
     /// Grow the model from a small sphere at this world point (x,y,z), which
     /// must lie inside the object (genus 0 only); with --auto, start from the
-    /// connected component holding this point instead of the largest.
+    /// connected component holding this point alone.
     #[arg(long, value_name = "x,y,z", value_parser = parse_triple, allow_hyphen_values = true, conflicts_with = "init")]
     pub seed: Option<[f64; 3]>,
-    /// Start from the boundary of the largest connected component above the
-    /// inside level (the iso-value, or Otsu's threshold); any genus. The default.
+    /// Start from the boundary of the object above the inside level (the
+    /// iso-value, or Otsu's threshold): its largest connected component and
+    /// every other of at least 1 % of its voxels, each a closed cage; any
+    /// genus. The default.
     #[arg(long)]
     pub auto: bool,
     /// Start from this closed control mesh instead (world coordinates).

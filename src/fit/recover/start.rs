@@ -29,8 +29,9 @@ pub enum RecoverStart {
         /// Radius in voxels.
         radius_voxels: Real,
     },
-    /// The cage of a connected component above the inside level
-    /// ([`component_cage`]): the one holding `seed`, else the largest; any
+    /// The cage of the object above the inside level ([`component_cage`]):
+    /// the connected component holding `seed`, else every part (the
+    /// largest component and those of at least 1 % of its voxels); any
     /// genus.
     Auto {
         /// World point selecting the component.
@@ -137,13 +138,14 @@ pub fn initial_model(
                 .transpose()?;
             let cage = component_cage(
                 smoother.as_ref().unwrap_or(volume),
+                volume,
                 prepared.inside_level,
                 bright_inside,
                 *seed,
                 *resolution,
             )?;
             let value = json!({"method": "auto", "component_voxels": cage.voxels,
-                "components": cage.components, "block_voxels": cage.block,
+                "components": cage.components, "parts": cage.parts, "block_voxels": cage.block,
                 "lost_voxels": cage.lost_voxels, "simplified_from_block": cage.simplified_from,
                 "genus": cage.genus, "boundary_points": cage.boundary.len(),
                 "vertices": cage.mesh.num_vertices(), "faces": cage.mesh.num_faces()});
