@@ -564,3 +564,57 @@ fn every_part_of_the_object_is_recovered_unless_a_seed_picks_one() {
     assert_eq!(seeded.parts, 1);
     assert!(seeded.mesh.positions.iter().all(|p| p.x < 27.0));
 }
+
+/// A rod the cage's volume lacks (as when its extra smoothing cuts a thin
+/// part below the level) but the forces' volume holds: its iso-surface
+/// points join the cage's for the two-sided forces, and a surface started
+/// from the ball grows out along it; the ball's own rim is not taken twice.
+#[test]
+fn a_part_only_the_forces_volume_holds_still_pulls_the_surface_out() {
+    let c = Point3::new(16.0, 20.0, 20.0);
+    let (from, tip) = (Point3::new(22.0, 20.0, 20.0), Point3::new(36.0, 20.0, 20.0));
+    let ball = move |p: Point3| (p - c).norm() - 9.0;
+    let with_rod = move |p: Point3| {
+        let t = ((p - from).dot(&(tip - from)) / (tip - from).norm_squared()).clamp(0.0, 1.0);
+        ball(p).min((p - (from + t * (tip - from))).norm() - 2.0)
+    };
+    let params = RecoverParams {
+        boundary: BoundaryModel::Iso { value: 0.5 },
+        ..Default::default()
+    };
+    let cage_volume = prepare_volume(&sdf_volume([42, 40, 40], [1.0; 3], ball), &params).unwrap();
+    let forces = prepare_volume(&sdf_volume([42, 40, 40], [1.0; 3], with_rod), &params).unwrap();
+    let alone = component_cage(
+        &cage_volume.smoothed,
+        &cage_volume.smoothed,
+        0.5,
+        true,
+        None,
+        12,
+    )
+    .unwrap();
+    let cage =
+        component_cage(&cage_volume.smoothed, &forces.smoothed, 0.5, true, None, 12).unwrap();
+    let reach = |points: &[Point3]| points.iter().map(|p| p.x).fold(Real::MIN, Real::max);
+    assert!(reach(&cage.mesh.positions) < 27.0);
+    assert!(reach(&alone.boundary) < 26.0 && reach(&cage.boundary) > 36.0);
+    // Only the rod's points were added: the ball's rim a voxel from it is not.
+    let added = &cage.boundary[alone.boundary.len()..];
+    assert_eq!(&cage.boundary[..alone.boundary.len()], &alone.boundary[..]);
+    assert!(added.iter().all(|p| p.x > 24.0), "{added:?}");
+    // From the ball's coarse cage, with each set of points.
+    let reach_from = |boundary: &[Point3]| {
+        let start = seed_cage(c, 9.0).unwrap();
+        let out =
+            recover_shape(&forces, &start, &[], boundary, &params, &mut |_, _, _| {}).unwrap();
+        let refiner = Refiner::new(&out.control, &RefineOptions::default()).unwrap();
+        let (tess, _) = tessellate(&refiner, &out.control.positions, 4).unwrap();
+        let poor = subdyn::fit::recover::poor_result(&out.report, &params);
+        (reach(&tess.positions), poor)
+    };
+    let (grown, poor) = reach_from(&cage.boundary);
+    let (stayed, _) = reach_from(&alone.boundary);
+    println!("surface reaches x = {grown:.2} with the rod's points, {stayed:.2} without");
+    assert!(poor.is_empty(), "{poor:?}");
+    assert!(grown > 36.0 && stayed < 30.0, "{grown} vs {stayed}");
+}
