@@ -3,13 +3,22 @@
 use super::{RecoverParams, RecoverReport};
 use crate::math::Real;
 
+/// The 95th percentile of the offsets (voxels) above which a result is
+/// poor, unless twice the tolerance is larger ([`poor_result`]).
+pub const POOR_OFFSET_VOXELS: Real = 1.0;
+
 /// Why the result of a recovery is poor, one sentence each; empty when it
 /// is not. A result is poor when the returned surface leaves the volume's
 /// (padded) box by more than a voxel anywhere, when more than
 /// `params.max_unresolved` of it found no boundary within its search range
 /// (the "unresolved" share: such samples follow the thin plate, not the
-/// image), or when a finer level followed the image worse than its parent
-/// (it is dropped, but the image disagrees with the model somewhere).
+/// image), when the 95th percentile of its offsets from the boundary is
+/// above [`POOR_OFFSET_VOXELS`] and twice the tolerance (the surface did not
+/// find the boundary it was given: pleats over a thin sheet, spikes; every
+/// result of the recovery bench and its check volumes ends at 0.5 voxel or
+/// less, the two poor ones at 1.5 and 2.2), or when a finer level followed
+/// the image worse than its parent (it is dropped, but the image disagrees
+/// with the model somewhere).
 pub fn poor_result(report: &RecoverReport, params: &RecoverParams) -> Vec<String> {
     let mut why = Vec::new();
     let Some(last) = report.levels.get(report.returned_level) else {
@@ -31,6 +40,13 @@ pub fn poor_result(report: &RecoverReport, params: &RecoverParams) -> Vec<String
             last.search_voxels,
             last.level,
             100.0 * params.max_unresolved
+        ));
+    }
+    let off = POOR_OFFSET_VOXELS.max(2.0 * params.tolerance_voxels);
+    if last.offsets.p95 > off {
+        why.push(format!(
+            "the surface is off the boundary at level {}: the 95th percentile of its offsets is {:.2} voxels, above {off:.2} (twice the tolerance, at least {POOR_OFFSET_VOXELS})",
+            last.level, last.offsets.p95
         ));
     }
     if let Some(worse) = report.levels.get(report.returned_level + 1) {
