@@ -2,12 +2,5 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use subdyn::io::{VolumeReadOptions, read_volume};
 
-fuzz_target!(|data: &[u8]| {
-    let dir = subdyn_fuzz::scratch(&["fuzz.exr"]);
-    let _ = read_volume(
-        subdyn_fuzz::file(&dir, "fuzz.exr", data),
-        &VolumeReadOptions::default(),
-    );
-});
+fuzz_target!(|data: &[u8]| subdyn_fuzz::read_volume_file("fuzz.exr", data));

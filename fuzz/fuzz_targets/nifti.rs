@@ -3,7 +3,6 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use subdyn::io::{VolumeReadOptions, read_volume};
 
 fuzz_target!(|data: &[u8]| {
     let name = if data.starts_with(&[0x1f, 0x8b]) {
@@ -11,9 +10,5 @@ fuzz_target!(|data: &[u8]| {
     } else {
         "fuzz.nii"
     };
-    let dir = subdyn_fuzz::scratch(&["fuzz.nii", "fuzz.nii.gz"]);
-    let _ = read_volume(
-        subdyn_fuzz::file(&dir, name, data),
-        &VolumeReadOptions::default(),
-    );
+    subdyn_fuzz::read_volume_file(name, data);
 });

@@ -41,6 +41,13 @@ pub fn file(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     p
 }
 
+/// Writes `data` to the file `name` in the scratch directory and reads it
+/// as a volume (the format from the name).
+pub fn read_volume_file(name: &str, data: &[u8]) {
+    let dir = scratch(&[name]);
+    let _ = subdyn::io::read_volume(file(&dir, name, data), &Default::default());
+}
+
 /// `data` cut at each `separator` into at most `max` parts (the last part
 /// keeps any further separators): how one fuzz input carries several files.
 pub fn parts<'a>(data: &'a [u8], separator: &[u8], max: usize) -> Vec<&'a [u8]> {
