@@ -109,3 +109,33 @@ pub(crate) fn check_finite(points: &[Point3]) -> Result<()> {
         None => Ok(()),
     }
 }
+
+impl PolyMesh {
+    /// The meshes side by side in one, in order (the second's vertex `i` is
+    /// `i` plus the first's vertex count, and so on): a control mesh of
+    /// several parts.
+    ///
+    /// ```
+    /// let cube = subdyn::examples::cube();
+    /// let two = subdyn::mesh::PolyMesh::disjoint_union(&[cube.clone(), cube.clone()]);
+    /// assert_eq!((two.num_vertices(), two.num_faces()), (16, 12));
+    /// assert_eq!(two.face(6), &cube.face(0).iter().map(|v| v + 8).collect::<Vec<_>>()[..]);
+    /// ```
+    pub fn disjoint_union(meshes: &[PolyMesh]) -> PolyMesh {
+        let mut out = PolyMesh {
+            positions: Vec::new(),
+            face_offsets: vec![0],
+            face_vertices: Vec::new(),
+        };
+        for m in meshes {
+            let base = out.positions.len() as u32;
+            let at = out.face_vertices.len() as u32;
+            out.positions.extend_from_slice(&m.positions);
+            out.face_vertices
+                .extend(m.face_vertices.iter().map(|&v| v + base));
+            out.face_offsets
+                .extend(m.face_offsets[1..].iter().map(|&o| o + at));
+        }
+        out
+    }
+}

@@ -1,18 +1,16 @@
 //! Initial models for recovering a shape from a volume: a small sphere-like
 //! cage at a seed point (grown by the inflation force), or the smoothed
-//! boundary of a thresholded connected component (any genus).
-
-use std::collections::VecDeque;
+//! boundary of the thresholded object, one closed cage per part (any genus).
 
 use crate::error::{Error, Result};
-use crate::fit::init::voxel_repair::make_manifold;
-use crate::fit::init::voxel_surface::{boundary_quads, taubin_smoothed};
-use crate::fit::init::voxels::{FACE_NEIGHBOURS, VoxelGrid};
-use crate::fit::init::{signed_volume, surface_topology};
+use crate::fit::init::signed_volume;
 use crate::math::{Point3, Real};
-use crate::mesh::{PolyMesh, simplified};
+use crate::mesh::PolyMesh;
 use crate::subdivision::{RefineOptions, Refiner};
 use crate::volume::Volume;
+
+use super::part_cage::part_cage;
+use super::voxel_components::{components, iso_crossings};
 
 /// A closed 26-vertex quad cage (the cube refined once, projected on a
 /// sphere) whose Catmull-Clark limit surface is a near-sphere of radius
@@ -233,7 +231,7 @@ pub fn component_cage(
         }
     }
     Ok(ComponentCage {
-        mesh: disjoint_union(&meshes),
+        mesh: PolyMesh::disjoint_union(&meshes),
         voxels: kept.iter().map(|&i| sizes[i]).sum(),
         components: sizes.len(),
         parts: kept.len(),
@@ -245,237 +243,8 @@ pub fn component_cage(
     })
 }
 
-/// The 6-connected components of the voxels inside the object: every
-/// voxel's label (`u32::MAX` outside), each component's voxel count and
-/// its box of voxel indices.
-#[allow(clippy::type_complexity)]
-fn components(
-    volume: &Volume,
-    level: Real,
-    bright_inside: bool,
-) -> (Vec<u32>, Vec<usize>, Vec<([usize; 3], [usize; 3])>) {
-    let dims = volume.dims();
-    let inside = |v: f32| {
-        let v = v as Real;
-        if bright_inside { v > level } else { v < level }
-    };
-    let n = volume.data().len();
-    let mut label = vec![u32::MAX; n];
-    let mut sizes: Vec<usize> = Vec::new();
-    let mut boxes: Vec<([usize; 3], [usize; 3])> = Vec::new();
-    let mut queue = VecDeque::new();
-    let coords = |i: usize| {
-        [
-            i % dims[0],
-            (i / dims[0]) % dims[1],
-            i / (dims[0] * dims[1]),
-        ]
-    };
-    for start in 0..n {
-        if label[start] != u32::MAX || !inside(volume.data()[start]) {
-            continue;
-        }
-        let id = sizes.len() as u32;
-        label[start] = id;
-        queue.push_back(start);
-        let (mut size, mut lo, mut hi) = (0, coords(start), coords(start));
-        while let Some(i) = queue.pop_front() {
-            size += 1;
-            let c = coords(i);
-            for a in 0..3 {
-                lo[a] = lo[a].min(c[a]);
-                hi[a] = hi[a].max(c[a]);
-            }
-            for d in FACE_NEIGHBOURS {
-                let w = [0, 1, 2].map(|a| c[a] as isize + d[a]);
-                if (0..3).any(|a| w[a] < 0 || w[a] >= dims[a] as isize) {
-                    continue;
-                }
-                let j = volume.index(w[0] as usize, w[1] as usize, w[2] as usize);
-                if label[j] == u32::MAX && inside(volume.data()[j]) {
-                    label[j] = id;
-                    queue.push_back(j);
-                }
-            }
-        }
-        sizes.push(size);
-        boxes.push((lo, hi));
-    }
-    (label, sizes, boxes)
-}
-
-/// One part's cage ([`component_cage`]'s construction for component
-/// `id` of `label`, in its box `lo..=hi`, at `block`-voxel blocks).
-struct PartCage {
-    mesh: PolyMesh,
-    lost: usize,
-    simplified_from: Option<usize>,
-    genus: i64,
-}
-
-/// The cage of component `id` (see [`component_cage`]); `None` when it
-/// vanishes at every block size tried.
-fn part_cage(
-    volume: &Volume,
-    label: &[u32],
-    id: u32,
-    (lo, hi): ([usize; 3], [usize; 3]),
-    block: usize,
-) -> Result<Option<PartCage>> {
-    let grid_of = |block: usize| -> Result<Option<(VoxelGrid, PolyMesh)>> {
-        let mut grid = block_grid(volume, label, id, (lo, hi), block);
-        grid.fill_cavities();
-        grid.keep_largest_component();
-        make_manifold(&mut grid);
-        grid.keep_largest_component();
-        if grid.count() == 0 {
-            return Ok(None);
-        }
-        // Block corner c is at voxel index lo + (c − margin) b − ½ (voxel faces).
-        let corner = |c: [usize; 3]| {
-            volume.world(
-                [0, 1, 2]
-                    .map(|a| lo[a] as Real + (c[a] as Real - MARGIN as Real) * block as Real - 0.5),
-            )
-        };
-        let mesh = taubin_smoothed(&boundary_quads(&grid, corner)?, 10);
-        Ok(Some((grid, mesh)))
-    };
-    let coarse = grid_of(block)?;
-    // Voxels of the component more than a block from every solid block: a
-    // part the blocks lost (a leg, a rod, a thin sheet).
-    let (mut size, mut lost) = (0usize, 0usize);
-    for z in lo[2]..=hi[2] {
-        for y in lo[1]..=hi[1] {
-            for x in lo[0]..=hi[0] {
-                if label[volume.index(x, y, z)] != id {
-                    continue;
-                }
-                size += 1;
-                let g = [x - lo[0], y - lo[1], z - lo[2]].map(|c| (c / block + MARGIN) as isize);
-                let near = coarse.as_ref().is_some_and(|(grid, _)| {
-                    NEIGHBOURHOOD
-                        .iter()
-                        .any(|d| grid.get([g[0] + d[0], g[1] + d[1], g[2] + d[2]]))
-                });
-                lost += usize::from(!near);
-            }
-        }
-    }
-    // When the blocks lost a part, the voxels' own boundary is simplified
-    // towards the coarse cage's number of vertices (at least a cube's
-    // refined once when the blocks kept nothing), with edges up to two
-    // blocks long (along the coarsest axis, so anisotropic voxels do not
-    // hold it back) so the cells stay about as even as the blocks'. Its
-    // topology may keep it above that; it is taken when it reaches that
-    // number or has at most a tenth of the boundary's vertices, else the
-    // boundary of blocks 2, 4, … voxels wide is tried (fine structure such
-    // as a folded sheet's tunnels fades at coarser blocks).
-    let target = coarse
-        .as_ref()
-        .map_or(MIN_PART_CAGE, |c| c.1.num_vertices());
-    let max_edge = 2.0 * block as Real * volume.spacing().into_iter().fold(0.0, Real::max);
-    let mut simplified_from = None;
-    let mut mesh = coarse.map(|c| c.1);
-    if lost as Real > LOST_PART * size as Real {
-        let mut fine = 1;
-        while fine < block.max(2) {
-            let Some((_, boundary)) = grid_of(fine)? else {
-                break;
-            };
-            let cage = simplified(&boundary, target, max_edge)?;
-            if cage.num_vertices() <= target.max(boundary.num_vertices() / 10) {
-                mesh = Some(cage);
-                simplified_from = Some(fine);
-                break;
-            }
-            fine *= 2;
-        }
-    }
-    let Some(mesh) = mesh else {
-        return Ok(None);
-    };
-    let mesh = oriented_outward(mesh)?;
-    let genus = surface_topology(&mesh)?.genus;
-    Ok(Some(PartCage {
-        mesh,
-        lost,
-        simplified_from,
-        genus,
-    }))
-}
-
-/// The vertices a part whose blocks kept nothing is simplified towards:
-/// a cube refined once.
-const MIN_PART_CAGE: usize = 26;
-
-/// The meshes side by side in one (vertices renumbered in order).
-fn disjoint_union(meshes: &[PolyMesh]) -> PolyMesh {
-    let mut out = PolyMesh {
-        positions: Vec::new(),
-        face_offsets: vec![0],
-        face_vertices: Vec::new(),
-    };
-    for m in meshes {
-        let base = out.positions.len() as u32;
-        let at = out.face_vertices.len() as u32;
-        out.positions.extend_from_slice(&m.positions);
-        out.face_vertices
-            .extend(m.face_vertices.iter().map(|&v| v + base));
-        out.face_offsets
-            .extend(m.face_offsets[1..].iter().map(|&o| o + at));
-    }
-    out
-}
-
-/// The points where the linear interpolant of `volume` crosses `level` on
-/// the edges from a voxel `i` with `take(i)` to a face neighbour with
-/// another `label`, which is not inside (components are maximal), in voxel
-/// order.
-fn iso_crossings(
-    volume: &Volume,
-    label: &[u32],
-    take: impl Fn(usize) -> bool,
-    level: Real,
-) -> Vec<Point3> {
-    let dims = volume.dims();
-    let data = volume.data();
-    let mut out = Vec::new();
-    for i in (0..label.len()).filter(|&i| take(i)) {
-        let chosen = label[i];
-        let c = [
-            i % dims[0],
-            (i / dims[0]) % dims[1],
-            i / (dims[0] * dims[1]),
-        ];
-        let a = data[i] as Real;
-        for d in FACE_NEIGHBOURS {
-            let w = [0, 1, 2].map(|k| c[k] as isize + d[k]);
-            if (0..3).any(|k| w[k] < 0 || w[k] >= dims[k] as isize) {
-                continue;
-            }
-            let j = volume.index(w[0] as usize, w[1] as usize, w[2] as usize);
-            if label[j] == chosen {
-                continue;
-            }
-            let b = data[j] as Real;
-            let t = if a == b {
-                0.5
-            } else {
-                ((a - level) / (a - b)).clamp(0.0, 1.0)
-            };
-            out.push(volume.world([0, 1, 2].map(|k| c[k] as Real + t * d[k] as Real)));
-        }
-    }
-    out
-}
-
-/// A component whose blocks lose more than this share of its voxels gets
-/// the simplified cage.
-const LOST_PART: Real = 0.002;
-
 /// The block and its 26 neighbours.
-const NEIGHBOURHOOD: [[isize; 3]; 27] = {
+pub(super) const NEIGHBOURHOOD: [[isize; 3]; 27] = {
     let mut n = [[0isize; 3]; 27];
     let mut i = 0;
     while i < 27 {
@@ -489,45 +258,9 @@ const NEIGHBOURHOOD: [[isize; 3]; 27] = {
     n
 };
 
-/// Empty cells around the blocks of [`block_grid`].
-const MARGIN: usize = 2;
-
-/// The blocks of `block³` voxels of the box `lo..=hi` holding component
-/// `chosen` of `label`, with [`MARGIN`] empty blocks around: a block is
-/// solid when at least half its voxels are in the component.
-fn block_grid(
-    volume: &Volume,
-    label: &[u32],
-    chosen: u32,
-    (lo, hi): ([usize; 3], [usize; 3]),
-    block: usize,
-) -> VoxelGrid {
-    let gdims = [0, 1, 2].map(|a| (hi[a] - lo[a] + 1).div_ceil(block) + 2 * MARGIN);
-    let mut grid = VoxelGrid::new(gdims);
-    let mut count = vec![0u32; grid.solid.len()];
-    for z in lo[2]..=hi[2] {
-        for y in lo[1]..=hi[1] {
-            for x in lo[0]..=hi[0] {
-                if label[volume.index(x, y, z)] == chosen {
-                    let g =
-                        [x - lo[0], y - lo[1], z - lo[2]].map(|c| (c / block + MARGIN) as isize);
-                    if let Some(i) = grid.index(g) {
-                        count[i] += 1;
-                    }
-                }
-            }
-        }
-    }
-    let half = (block * block * block).div_ceil(2) as u32;
-    for (s, &c) in grid.solid.iter_mut().zip(&count) {
-        *s = c >= half.max(1);
-    }
-    grid
-}
-
 /// The mesh with faces reversed if its signed volume is negative (a
 /// voxel-to-world map with negative determinant mirrors orientation).
-fn oriented_outward(mesh: PolyMesh) -> Result<PolyMesh> {
+pub(super) fn oriented_outward(mesh: PolyMesh) -> Result<PolyMesh> {
     if signed_volume(&mesh) < 0.0 {
         crate::fit::init::surface::reversed(&mesh)
     } else {

@@ -6,10 +6,12 @@ mod driver;
 mod init;
 mod pad;
 mod params;
+mod part_cage;
 mod prepare;
 mod quality;
 mod report;
 mod start;
+mod voxel_components;
 
 pub use driver::{RecoverResult, recover_shape};
 pub use init::{ComponentCage, component_cage, seed_cage};
