@@ -136,6 +136,22 @@ impl Volume {
         i + self.dims[0] * (j + self.dims[1] * k)
     }
 
+    /// Voxel `(i, j, k)` of linear index `n` (the inverse of [`index`](Self::index)).
+    #[inline]
+    pub fn voxel(&self, n: usize) -> [usize; 3] {
+        let d = self.dims;
+        [n % d[0], (n / d[0]) % d[1], n / (d[0] * d[1])]
+    }
+
+    /// Linear index of voxel `v + d`, or `None` outside the grid.
+    #[inline]
+    pub fn offset_index(&self, v: [usize; 3], d: [isize; 3]) -> Option<usize> {
+        let w = [0, 1, 2].map(|a| v[a] as isize + d[a]);
+        (0..3)
+            .all(|a| w[a] >= 0 && w[a] < self.dims[a] as isize)
+            .then(|| self.index(w[0] as usize, w[1] as usize, w[2] as usize))
+    }
+
     /// The sample at voxel `(i, j, k)` (panics out of range, like slice indexing).
     #[inline]
     pub fn at(&self, i: usize, j: usize, k: usize) -> f32 {

@@ -211,18 +211,14 @@ pub fn component_cage(
             // Voxels a voxel or more from every part voxel: not the rim
             // that the extra smoothing shaves off every part (taking that
             // would only add points along every fold of a brain).
-            let dims = volume.dims();
+            // (A part voxel is in its own neighbourhood: checked first.)
             let apart = |i: usize| {
-                let c = [
-                    i % dims[0],
-                    (i / dims[0]) % dims[1],
-                    i / (dims[0] * dims[1]),
-                ];
-                !NEIGHBOURHOOD.iter().any(|d| {
-                    let w = [0, 1, 2].map(|a| c[a] as isize + d[a]);
-                    (0..3).all(|a| w[a] >= 0 && w[a] < dims[a] as isize)
-                        && in_part(volume.index(w[0] as usize, w[1] as usize, w[2] as usize))
-                })
+                let c = volume.voxel(i);
+                !in_part(i)
+                    && !NEIGHBOURHOOD
+                        .iter()
+                        .filter_map(|&d| volume.offset_index(c, d))
+                        .any(in_part)
             };
             let lost = |i: usize| {
                 force_label[i] != u32::MAX && overlap[force_label[i] as usize] > 0 && apart(i)

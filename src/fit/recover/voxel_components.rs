@@ -17,7 +17,6 @@ pub(super) fn components(
     level: Real,
     bright_inside: bool,
 ) -> (Vec<u32>, Vec<usize>, Vec<([usize; 3], [usize; 3])>) {
-    let dims = volume.dims();
     let inside = |v: f32| {
         let v = v as Real;
         if bright_inside { v > level } else { v < level }
@@ -27,13 +26,6 @@ pub(super) fn components(
     let mut sizes: Vec<usize> = Vec::new();
     let mut boxes: Vec<([usize; 3], [usize; 3])> = Vec::new();
     let mut queue = VecDeque::new();
-    let coords = |i: usize| {
-        [
-            i % dims[0],
-            (i / dims[0]) % dims[1],
-            i / (dims[0] * dims[1]),
-        ]
-    };
     for start in 0..n {
         if label[start] != u32::MAX || !inside(volume.data()[start]) {
             continue;
@@ -41,20 +33,18 @@ pub(super) fn components(
         let id = sizes.len() as u32;
         label[start] = id;
         queue.push_back(start);
-        let (mut size, mut lo, mut hi) = (0, coords(start), coords(start));
+        let (mut size, mut lo, mut hi) = (0, volume.voxel(start), volume.voxel(start));
         while let Some(i) = queue.pop_front() {
             size += 1;
-            let c = coords(i);
+            let c = volume.voxel(i);
             for a in 0..3 {
                 lo[a] = lo[a].min(c[a]);
                 hi[a] = hi[a].max(c[a]);
             }
-            for d in FACE_NEIGHBOURS {
-                let w = [0, 1, 2].map(|a| c[a] as isize + d[a]);
-                if (0..3).any(|a| w[a] < 0 || w[a] >= dims[a] as isize) {
-                    continue;
-                }
-                let j = volume.index(w[0] as usize, w[1] as usize, w[2] as usize);
+            for j in FACE_NEIGHBOURS
+                .iter()
+                .filter_map(|&d| volume.offset_index(c, d))
+            {
                 if label[j] == u32::MAX && inside(volume.data()[j]) {
                     label[j] = id;
                     queue.push_back(j);
@@ -77,23 +67,16 @@ pub(super) fn iso_crossings(
     take: impl Fn(usize) -> bool,
     level: Real,
 ) -> Vec<Point3> {
-    let dims = volume.dims();
     let data = volume.data();
     let mut out = Vec::new();
     for i in (0..label.len()).filter(|&i| take(i)) {
         let chosen = label[i];
-        let c = [
-            i % dims[0],
-            (i / dims[0]) % dims[1],
-            i / (dims[0] * dims[1]),
-        ];
+        let c = volume.voxel(i);
         let a = data[i] as Real;
         for d in FACE_NEIGHBOURS {
-            let w = [0, 1, 2].map(|k| c[k] as isize + d[k]);
-            if (0..3).any(|k| w[k] < 0 || w[k] >= dims[k] as isize) {
+            let Some(j) = volume.offset_index(c, d) else {
                 continue;
-            }
-            let j = volume.index(w[0] as usize, w[1] as usize, w[2] as usize);
+            };
             if label[j] == chosen {
                 continue;
             }
