@@ -2,16 +2,11 @@
 //! streams also from a `.ply.gz` file.
 #![no_main]
 
-use std::path::Path;
-
 use libfuzzer_sys::fuzz_target;
-use subdyn::io::{MeshFormat, read_mesh_from_bytes, read_points_from_bytes};
+use subdyn::io::MeshFormat;
 
 fuzz_target!(|data: &[u8]| {
-    subdyn_fuzz::init();
-    let name = Path::new("fuzz.ply");
-    let _ = read_mesh_from_bytes(data, MeshFormat::Ply, name);
-    let _ = read_points_from_bytes(data, MeshFormat::Ply, name);
+    subdyn_fuzz::read_mesh_and_points(data, MeshFormat::Ply);
     // A gzip stream goes through the file reader's capped inflation.
     if data.starts_with(&[0x1f, 0x8b]) {
         let dir = subdyn_fuzz::scratch(&["fuzz.ply.gz"]);

@@ -41,6 +41,14 @@ pub fn file(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     p
 }
 
+/// Parses `data` as a mesh and as a point cloud in `format`.
+pub fn read_mesh_and_points(data: &[u8], format: subdyn::io::MeshFormat) {
+    init();
+    let name = Path::new("fuzz");
+    let _ = subdyn::io::read_mesh_from_bytes(data, format, name);
+    let _ = subdyn::io::read_points_from_bytes(data, format, name);
+}
+
 /// Writes `data` to the file `name` in the scratch directory and reads it
 /// as a volume (the format from the name).
 pub fn read_volume_file(name: &str, data: &[u8]) {
