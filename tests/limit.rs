@@ -11,6 +11,7 @@
 mod common;
 
 use common::*;
+use std::f64::consts::TAU;
 use subdyn::limit::{
     ClosestPointEngine, ClosestPointParams, LimitEvaluator, LimitPoint, PatchTable, Sample,
     cubic_basis, limit_stencil, tessellate,
@@ -1269,6 +1270,85 @@ fn patch_position_equals_the_evaluated_point() {
                 }
             }
         }
+    }
+}
+
+/// Near a vertex of high valence (a fan of 40 and of 100 quads, wavy so
+/// that nothing is planar) `eval` follows the innermost cell towards the
+/// vertex once and reuses it: its points still equal the exact
+/// evaluator's, from 1/256 of the corner down to 1e-13 of it, and its
+/// first derivatives match central differences.
+#[test]
+fn evaluation_near_a_vertex_of_high_valence_is_exact() {
+    for n in [40usize, 100] {
+        let mut p = vec![Point3::new(0.0, 0.0, 0.3)];
+        for i in 0..n {
+            let (a, b) = (TAU * i as f64 / n as f64, TAU * (i as f64 + 0.5) / n as f64);
+            p.push(Point3::new(a.cos(), a.sin(), 0.1 * (3.0 * a).sin()));
+            p.push(Point3::new(
+                1.5 * b.cos(),
+                1.5 * b.sin(),
+                0.1 * (5.0 * b).cos(),
+            ));
+        }
+        let faces: Vec<Vec<u32>> = (0..n as u32)
+            .map(|i| vec![0, 1 + 2 * i, 2 + 2 * i, 1 + 2 * ((i + 1) % n as u32)])
+            .collect();
+        let fan = PolyMesh::from_faces(p, &faces).unwrap();
+        let d = diag(&fan.positions);
+        let r = default_refiner(&fan);
+        let table = PatchTable::new(&r, &fan.positions, 1).unwrap();
+        let eval = LimitEvaluator::new(&r);
+        let mut checked = 0;
+        for f in 0..table.num_patches() {
+            // Only the patches whose corner (0, 0) is the fan's centre
+            // (every face lists it first).
+            let s = table.sample(f, [0.0, 0.0]);
+            if (s.u, s.v) != (0.0, 0.0) {
+                continue;
+            }
+            for st in [
+                [0.004, 0.002],
+                [0.002, 0.003],
+                [3e-6, 1e-6],
+                [1e-9, 2e-9],
+                [1e-13, 0.0],
+            ] {
+                let e = table.eval(f, st).unwrap();
+                let s = table.sample(f, st);
+                let exact = eval
+                    .evaluate(s.face as usize, s.u, s.v, &fan.positions)
+                    .unwrap();
+                assert!(
+                    (e.p - exact.p).norm() <= 1e-12 * d,
+                    "valence {n}: patch {f} at {st:?}: {} against the evaluator's {}",
+                    e.p,
+                    exact.p
+                );
+                if st[0] < 1e-3 {
+                    continue;
+                }
+                let h = 1e-7;
+                for (k, step) in [[h, 0.0], [0.0, h]].iter().enumerate() {
+                    let at = |sign: f64| {
+                        table
+                            .position(f, [st[0] + sign * step[0], st[1] + sign * step[1]])
+                            .unwrap()
+                    };
+                    let fd = (at(1.0) - at(-1.0)) / (2.0 * h);
+                    assert!(
+                        (fd - e.d[k]).norm() <= 1e-5 * e.d[k].norm().max(d),
+                        "valence {n}: patch {f} at {st:?}: derivative {k} {} against {fd}",
+                        e.d[k]
+                    );
+                }
+            }
+            checked += 1;
+        }
+        assert_eq!(
+            checked, n,
+            "valence {n}: one patch per fan face at the centre"
+        );
     }
 }
 

@@ -13,7 +13,7 @@
 //! needed: the refined 1-ring of a sub-face depends on the 1-ring of its
 //! parent alone (vertex rules read only the corners' rings, which are whole).
 
-use crate::math::Real;
+use crate::math::{Real, Vector3};
 use crate::stencil::RowBuilder;
 use crate::subdivision::{refine_stencil, refine_topology};
 use crate::topology::{Level, NONE, SHARPNESS_INFINITE, Sharpness, VertexRule, find_edge};
@@ -126,6 +126,32 @@ impl LocalPatch {
         }
     }
 
+    /// This patch with every local vertex's row applied to the values of
+    /// its columns (`value(i)` for column `i`, in order): a patch whose
+    /// three columns are x, y and z. Refining it costs O(vertices) instead of O(vertices ×
+    /// columns), which is what keeps evaluation near a vertex of high
+    /// valence affordable; [`evaluate_local`] then returns coordinates as
+    /// its weights.
+    pub(crate) fn applied(&self, value: impl Fn(usize) -> Vector3) -> LocalPatch {
+        let nc = self.ncols();
+        let values: Vec<Vector3> = (0..nc).map(value).collect();
+        let mut rows = Vec::with_capacity(3 * self.level.num_vertices);
+        for r in self.rows.chunks(nc.max(1)).take(self.level.num_vertices) {
+            let p = r
+                .iter()
+                .zip(&values)
+                .fold(Vector3::zeros(), |p, (&w, v)| p + v * w);
+            rows.extend_from_slice(&[p.x, p.y, p.z]);
+        }
+        LocalPatch {
+            level: self.level.clone(),
+            sharp: self.sharp.clone(),
+            cols: vec![0, 1, 2],
+            rows,
+            face: self.face,
+        }
+    }
+
     /// The 1-ring of local face `face`, as a patch of its own.
     pub(crate) fn extract(&self, face: u32) -> LocalPatch {
         let (sub, map) = Ring::of(&self.level, face as usize).sub_mesh(&self.level, &self.sharp);
@@ -198,33 +224,44 @@ pub(crate) struct Ring {
 impl Ring {
     /// The ring of `face` in `level`.
     pub(crate) fn of(level: &Level, face: usize) -> Ring {
-        let mut faces: Vec<u32> = vec![face as u32];
-        let mut firsts = vec![0];
+        // Every face around every corner, each with the corner it was
+        // reached through; a face met again keeps its first entry. The
+        // duplicates are found by sorting, not by searching the list, so a
+        // vertex of high valence costs O(n log n), not O(n²).
+        let mut met: Vec<(u32, usize)> = vec![(face as u32, 0)];
         for &v in level.face_vertices(face) {
             for g in faces_around(level, face, v) {
-                if !faces.contains(&g) {
-                    let k = level.face_vertices(g as usize).iter().position(|&w| w == v);
-                    faces.push(g);
-                    firsts.push(k.unwrap_or(0));
-                }
+                let k = level.face_vertices(g as usize).iter().position(|&w| w == v);
+                met.push((g, k.unwrap_or(0)));
             }
         }
-        let mut map: Vec<u32> = Vec::new();
+        let first = first_occurrences(&met.iter().map(|m| m.0).collect::<Vec<_>>());
+        let (faces, firsts): (Vec<u32>, Vec<usize>) = met
+            .iter()
+            .zip(first)
+            .enumerate()
+            .filter(|&(i, (_, f))| f as usize == i)
+            .map(|(_, (&m, _))| m)
+            .unzip();
         let mut offsets = vec![0u32];
-        let mut verts = Vec::new();
+        let mut corners = Vec::new();
         for (&g, &first) in faces.iter().zip(&firsts) {
             let fv = level.face_vertices(g as usize);
-            for &v in fv[first..].iter().chain(&fv[..first]) {
-                let l = match map.iter().position(|&x| x == v) {
-                    Some(l) => l,
-                    None => {
-                        map.push(v);
-                        map.len() - 1
-                    }
-                };
-                verts.push(l as u32);
-            }
-            offsets.push(verts.len() as u32);
+            corners.extend(fv[first..].iter().chain(&fv[..first]));
+            offsets.push(corners.len() as u32);
+        }
+        // Local vertices numbered in order of first appearance.
+        let first = first_occurrences(&corners);
+        let mut map: Vec<u32> = Vec::new();
+        let mut verts: Vec<u32> = Vec::with_capacity(corners.len());
+        for (i, &f) in first.iter().enumerate() {
+            let l = if f as usize == i {
+                map.push(corners[i]);
+                map.len() as u32 - 1
+            } else {
+                verts[f as usize]
+            };
+            verts.push(l);
         }
         Ring {
             faces,
@@ -416,6 +453,127 @@ pub(crate) fn evaluate_local(
         patch.descend(k);
         depth += 1;
     }
+}
+
+/// For each item, the index of the first item equal to it, found by sorting
+/// (O(n log n)).
+fn first_occurrences(items: &[u32]) -> Vec<u32> {
+    let mut order: Vec<u32> = (0..items.len() as u32).collect();
+    order.sort_unstable_by_key(|&i| (items[i as usize], i));
+    let mut first = vec![0; items.len()];
+    let mut start = 0;
+    for (k, &i) in order.iter().enumerate() {
+        if k == 0 || items[order[k - 1] as usize] != items[i as usize] {
+            start = i;
+        }
+        first[i as usize] = start;
+    }
+    first
+}
+
+/// A cell at an irregular corner followed towards the corner, so that
+/// evaluating near a vertex of high valence does not subdivide its whole
+/// ring again at every level for every point: link `i` holds, for the cell
+/// subdivided `i` times around the corner, the 16 control points of its
+/// children on the other three quadrants (regular, hence one bicubic patch
+/// each). Evaluation walks the links to the first quadrant off the corner.
+/// The result is what [`evaluate_local`] gives, which is still used where
+/// the chain stops (a second irregular corner, or [`MAX_DEPTH`]) and
+/// exactly at the corner.
+pub(crate) struct CornerChain {
+    cell: LocalPatch,
+    /// Subdivisions of the cell below its base face.
+    depth: usize,
+    links: Vec<ChainLink>,
+    /// The cell subdivided around the corner once per link.
+    end: LocalPatch,
+}
+
+/// A level of a [`CornerChain`]: the quadrant the chain goes on into and
+/// the other quadrants' grid rows ([`LocalPatch::grid_rows`]) where their
+/// children are regular.
+struct ChainLink {
+    corner: usize,
+    grids: [Option<Vec<Real>>; 4],
+}
+
+impl CornerChain {
+    /// The chain of `cell`, `depth` subdivisions below its base face.
+    pub(crate) fn new(cell: LocalPatch, depth: usize) -> CornerChain {
+        let mut links = Vec::new();
+        let mut end = cell.clone();
+        for _ in depth..MAX_DEPTH {
+            let fv = end.level.face_vertices(end.face as usize);
+            let irregular: Vec<usize> = (0..fv.len())
+                .filter(|&k| {
+                    corner_kind(&end.level, &end.sharp, fv[k] as usize, end.face)
+                        == CornerKind::Irregular
+                })
+                .collect();
+            let &[corner] = &irregular[..] else { break };
+            let refined = end.refined();
+            let grids = std::array::from_fn(|k| {
+                let child = refined.child_face(k);
+                (k != corner && refined.is_regular(child)).then(|| refined.grid_rows(child))
+            });
+            end = refined.extract(end.child_face(corner));
+            links.push(ChainLink { corner, grids });
+        }
+        CornerChain {
+            cell,
+            depth,
+            links,
+            end,
+        }
+    }
+
+    /// The weights (over the cell's columns) of the position and
+    /// derivatives at the cell's `(s, t)`, as [`evaluate_local`] gives them.
+    pub(crate) fn evaluate(&self, at: [Real; 2]) -> SampleStencil {
+        let (mut st, mut jac) = (at, IDENTITY);
+        for link in &self.links {
+            let k = quadrant(st);
+            let (child, m) = child_frame(k, st);
+            if k != link.corner {
+                return match &link.grids[k] {
+                    Some(grid) => grid_patch(&self.cell, grid, child, mat_mul(m, jac)),
+                    None => evaluate_local(self.cell.clone(), at, IDENTITY, self.depth),
+                };
+            }
+            if st == CORNERS[k] {
+                return evaluate_local(self.cell.clone(), at, IDENTITY, self.depth);
+            }
+            st = child;
+            jac = mat_mul(m, jac);
+        }
+        let depth = self.depth + self.links.len();
+        evaluate_local(self.end.clone(), st, jac, depth)
+    }
+}
+
+const IDENTITY: [[Real; 2]; 2] = [[1.0, 0.0], [0.0, 1.0]];
+
+/// [`regular_patch`] of a patch given by its 16 grid rows over the columns
+/// of `like`.
+fn grid_patch(
+    like: &LocalPatch,
+    grid: &[Real],
+    st: [Real; 2],
+    jac: [[Real; 2]; 2],
+) -> SampleStencil {
+    let nc = like.ncols();
+    let w = patch_weights(st[0], st[1]);
+    let mut local: [Vec<Real>; 6] = std::array::from_fn(|_| vec![0.0; nc]);
+    for (i, row) in grid.chunks(nc.max(1)).enumerate() {
+        for q in 0..6 {
+            if w[q][i] != 0.0 {
+                for (o, &x) in local[q].iter_mut().zip(row) {
+                    *o += w[q][i] * x;
+                }
+            }
+        }
+    }
+    chain_rule(like, local, jac)
 }
 
 /// The quadrant of `(s, t)`: the child at corner 0, 1, 2 or 3. Ties go to

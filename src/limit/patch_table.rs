@@ -33,14 +33,20 @@ use crate::topology::{Level, Sharpness};
 
 use super::bspline::{cubic_basis, patch_weights, position_weights};
 use super::patch::{
-    CORNERS, LocalPatch, Ring, SampleStencil, child_frame, evaluate_face, evaluate_local, mat_mul,
-    mat_vec, patch_grid, quadrant,
+    CORNERS, CornerChain, LocalPatch, Ring, SampleStencil, child_frame, evaluate_face,
+    evaluate_local, mat_mul, mat_vec, patch_grid, quadrant,
 };
 use super::vertex_masks::{CornerKind, corner_kind};
 use super::{LimitEvaluator, LimitPoint, Sample};
 
 /// Levels of local subdivision below `L` for faces at irregular vertices.
 pub const TREE_DEPTH: usize = 6;
+
+/// Rings of more columns than this (a vertex of valence above about 28)
+/// evaluate their innermost cells through a [`CornerChain`]: exact
+/// evaluation there otherwise subdivides the whole ring at every level,
+/// for every point (O(levels × ring²) per point).
+const CHAIN_COLUMNS: usize = 64;
 
 /// A level-`L` face: its place in its base face and, near an irregular
 /// vertex, its quadtree.
@@ -61,9 +67,17 @@ struct Tree {
     cols: Vec<u32>,
     /// The leaves, shared by the faces of one structure.
     shape: Arc<Shape>,
-    /// Each leaf's control points at the current positions, made on first
-    /// use (cleared by `set_positions`).
-    points: Vec<OnceLock<Box<[Point3; 16]>>>,
+    /// Each leaf at the current positions, made on first use (cleared by
+    /// `set_positions`).
+    points: Vec<OnceLock<LeafPoints>>,
+}
+
+/// A quadtree leaf at the current positions: a regular leaf's 16 control
+/// points, or the innermost cell's local patch applied to the positions
+/// ([`LocalPatch::applied`]) and followed towards its irregular vertex.
+enum LeafPoints {
+    Grid(Box<[Point3; 16]>),
+    Cell(Box<CornerChain>),
 }
 
 impl Tree {
@@ -78,11 +92,12 @@ impl Tree {
     }
 
     /// The innermost cell holding `(s, t)` (where [`leaf_at`](Self::leaf_at)
-    /// finds none), and the point in its `(s', t')`.
-    fn cell_at(&self, st: [Real; 2]) -> Option<(&Leaf, &LocalPatch, [Real; 2])> {
-        self.shape.leaves.iter().find_map(|leaf| {
+    /// finds none): its index, the leaf, its local patch and the point in
+    /// its `(s', t')`.
+    fn cell_at(&self, st: [Real; 2]) -> Option<(usize, &Leaf, &LocalPatch, [Real; 2])> {
+        self.shape.leaves.iter().enumerate().find_map(|(i, leaf)| {
             let x = leaf.local(st)?;
-            Some((leaf, &**leaf.cell.as_ref()?, x))
+            Some((i, leaf, &**leaf.cell.as_ref()?, x))
         })
     }
 }
@@ -366,20 +381,30 @@ impl PatchTable {
         let patch = &self.patches[f];
         // The innermost cell at the irregular vertex: exact evaluation from
         // the cell's local patch (its weights are over the tree's columns,
-        // in order). Exactly at a corner the evaluator's corner tangents
-        // (which depend on the depth they are taken at) are kept.
+        // in order), followed towards the vertex once per positions when
+        // its ring is large. Exactly at a corner the evaluator's corner
+        // tangents (which depend on the depth they are taken at) are kept.
         if let Some(tree) = patch.tree.get()
-            && let Some((leaf, cell, x)) = tree.cell_at(st)
+            && let Some((i, leaf, cell, x)) = tree.cell_at(st)
             && !CORNERS.contains(&x)
         {
-            let s = evaluate_local(cell.clone(), x, [[1.0, 0.0], [0.0, 1.0]], TREE_DEPTH);
-            let q: [Vector3; 6] = std::array::from_fn(|k| {
-                s.weights[k]
-                    .iter()
-                    .zip(&tree.cols)
-                    .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
-                    .sum()
-            });
+            let q: [Vector3; 6] = if tree.cols.len() > CHAIN_COLUMNS
+                && let LeafPoints::Cell(corner) = tree.points[i].get_or_init(|| {
+                    let cell = cell.applied(|l| self.level_positions[tree.cols[l] as usize].coords);
+                    LeafPoints::Cell(Box::new(CornerChain::new(cell, TREE_DEPTH)))
+                }) {
+                let s = corner.evaluate(x);
+                std::array::from_fn(|k| Vector3::from_column_slice(&s.weights[k]))
+            } else {
+                let s = evaluate_local(cell.clone(), x, [[1.0, 0.0], [0.0, 1.0]], TREE_DEPTH);
+                std::array::from_fn(|k| {
+                    s.weights[k]
+                        .iter()
+                        .zip(&tree.cols)
+                        .map(|(&w, &c)| w * self.level_positions[c as usize].coords)
+                        .sum()
+                })
+            };
             return Ok(PatchPoint {
                 p: Point3::from(q[0]),
                 d: chain([q[1], q[2], q[3], q[4], q[5]], leaf.jac),
@@ -702,8 +727,8 @@ impl PatchTable {
         let (i, leaf, rows, x) = tree.leaf_at(st)?;
         let cols = &tree.cols;
         let nc = cols.len().max(1);
-        let grid = tree.points[i].get_or_init(|| {
-            Box::new(std::array::from_fn(|k| {
+        let points = tree.points[i].get_or_init(|| {
+            LeafPoints::Grid(Box::new(std::array::from_fn(|k| {
                 let mut p = [0.0; 3];
                 for (&w, &c) in rows[k * nc..(k + 1) * nc].iter().zip(cols) {
                     let q = &self.level_positions[c as usize];
@@ -712,8 +737,11 @@ impl PatchTable {
                     p[2] += w * q.z;
                 }
                 Point3::from(p)
-            }))
+            })))
         });
+        let LeafPoints::Grid(grid) = points else {
+            return None;
+        };
         Some((grid, x, Some(leaf.jac)))
     }
 

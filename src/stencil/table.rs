@@ -298,17 +298,45 @@ impl StencilTable {
 pub struct RowBuilder {
     cols: Vec<u32>,
     wts: Vec<Real>,
+    /// `(column, position in cols)` sorted by column, kept only once the row
+    /// is longer than [`LINEAR_SEARCH`] (the mask of a vertex of high
+    /// valence), so that merging stays O(log n) per entry there.
+    sorted: Vec<(u32, u32)>,
 }
+
+/// Rows up to this long are searched entry by entry.
+const LINEAR_SEARCH: usize = 32;
 
 impl RowBuilder {
     /// Adds `w` to the weight of column `c`.
     #[inline]
     pub fn add(&mut self, c: u32, w: Real) {
-        match self.cols.iter().position(|&x| x == c) {
+        let at = if self.cols.len() <= LINEAR_SEARCH {
+            self.cols.iter().position(|&x| x == c)
+        } else {
+            self.sorted_position(c)
+        };
+        match at {
             Some(k) => self.wts[k] += w,
             None => {
                 self.cols.push(c);
                 self.wts.push(w);
+            }
+        }
+    }
+
+    /// The position of column `c` by binary search in `sorted` (made on
+    /// first use); a new column is entered at the position it will take.
+    fn sorted_position(&mut self, c: u32) -> Option<usize> {
+        if self.sorted.len() < self.cols.len() {
+            self.sorted = self.cols.iter().zip(0..).map(|(&c, k)| (c, k)).collect();
+            self.sorted.sort_unstable();
+        }
+        match self.sorted.binary_search_by_key(&c, |e| e.0) {
+            Ok(k) => Some(self.sorted[k].1 as usize),
+            Err(k) => {
+                self.sorted.insert(k, (c, self.cols.len() as u32));
+                None
             }
         }
     }
@@ -324,6 +352,7 @@ impl RowBuilder {
     pub fn clear(&mut self) {
         self.cols.clear();
         self.wts.clear();
+        self.sorted.clear();
     }
 
     /// The entries so far.
