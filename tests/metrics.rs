@@ -401,6 +401,56 @@ fn self_intersections_match_brute_force() {
     }
 }
 
+/// The pairs after some vertices moved, found by testing again only the
+/// triangles that moved, are the full search's: on a crumpled grid whose
+/// middle is pushed through the rest, and back (the pairs it had go away),
+/// and on soups with a few triangles moved.
+#[test]
+fn self_intersections_after_a_local_move_match_the_full_search() {
+    let mut rng = Rng(29);
+    let mut crumpled = grid(24, 0.0);
+    for q in &mut crumpled.positions {
+        *q += 0.3 * (rng.point(1.0) - Point3::origin());
+    }
+    let before = TriangleBvh::from_mesh(&crumpled).unwrap();
+    let mut pushed = before.positions().to_vec();
+    let centre = pushed[pushed.len() / 2];
+    let mut moved = 0;
+    for q in &mut pushed {
+        if (*q - centre).norm() < 2.5 {
+            q.x += 2.0;
+            q.z += 0.2;
+            moved += 1;
+        }
+    }
+    let after = TriangleBvh::new(pushed.clone(), before.triangles().to_vec()).unwrap();
+    let (old, new) = (before.self_intersections(), after.self_intersections());
+    assert!(
+        moved > 5 && moved < pushed.len() / 4,
+        "{moved} vertices moved"
+    );
+    assert_ne!(old, new, "the move must change the pairs");
+    assert_eq!(before.self_intersections_moved(&old, &pushed).unwrap(), new);
+    assert_eq!(
+        after
+            .self_intersections_moved(&new, before.positions())
+            .unwrap(),
+        old
+    );
+    for (n, size) in [(400, 0.2), (1500, 0.08)] {
+        let soup = random_soup(&mut rng, n, size);
+        let pairs = soup.self_intersections();
+        let mut p = soup.positions().to_vec();
+        for t in soup.triangles().iter().step_by(7) {
+            p[t[0] as usize] += rng.point(size).coords;
+        }
+        let want = TriangleBvh::new(p.clone(), soup.triangles().to_vec())
+            .unwrap()
+            .self_intersections();
+        assert_eq!(soup.self_intersections_moved(&pairs, &p).unwrap(), want);
+    }
+}
+
 #[test]
 fn rays_through_shared_edges_and_vertices_hit_a_closed_mesh() {
     // Every ray from the cube's centre through an edge midpoint or a corner

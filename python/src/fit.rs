@@ -30,6 +30,7 @@ const FIT_OPTIONS: &[&str] = &[
     "bending",
     "fairness",
     "untangle_rounds",
+    "final_untangle_rounds",
     "init_resolution",
     "mass",
     "tess",
@@ -136,6 +137,7 @@ fn fit_params(o: &Options<'_, '_>) -> PyResult<FitParams> {
         bending: o.f64("bending", d.bending)?,
         fairness: o.f64("fairness", d.fairness)?,
         untangle_rounds: o.usize("untangle_rounds", d.untangle_rounds)?,
+        final_untangle_rounds: o.usize("final_untangle_rounds", d.final_untangle_rounds)?,
         mass: o.f64("mass", d.mass)?,
         ..d
     };

@@ -136,7 +136,7 @@ def fit(points: Any, normals: Any = None, **options: Any) -> FitResult:
     diagonal), ``tol_stat`` ("p95"; "max", "rms", "mean"), ``max_level`` (3),
     ``refine`` ("adaptive" or "uniform"), ``refine_significance``,
     ``refine_off_data``, ``tension``, ``bending``, ``fairness``,
-    ``untangle_rounds``, ``mass``,
+    ``untangle_rounds``, ``final_untangle_rounds``, ``mass``,
     ``init`` ("auto", "closed", "open", "occupancy", or a ``(vertices,
     faces)`` control mesh), ``init_resolution``, ``tess`` (4, the limit
     surface's samples per quad edge), ``quads`` (False), and ``threads``

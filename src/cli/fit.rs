@@ -100,6 +100,11 @@ pub struct FitArgs {
     /// smooth and stiffen the faces there and refit (0 turns it off).
     #[arg(long, value_name = "N", default_value_t = FitParams::default().untangle_rounds)]
     pub untangle_rounds: usize,
+    /// Untangling rounds after the last level: where the limit surface
+    /// still crosses itself, smooth the faces there without a refit, while
+    /// the crossings get fewer (0 turns it off).
+    #[arg(long, value_name = "N", default_value_t = FitParams::default().final_untangle_rounds)]
+    pub final_untangle_rounds: usize,
     /// Resolution of the automatic initial model: voxels along the longest
     /// axis of the occupancy cage, grid cells of the open grid. Holes and gaps
     /// narrower than about 4 voxels close up; raise it for thin gaps.
@@ -165,6 +170,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         bending: args.bending,
         fairness: args.fairness,
         untangle_rounds: args.untangle_rounds,
+        final_untangle_rounds: args.final_untangle_rounds,
         mass: args.mass,
         ..Default::default()
     };

@@ -43,11 +43,11 @@ use super::init::voxel_surface::taubin_smoothed_where;
 
 use super::fairness::{umbrella_matrix, vertex_rings};
 use super::levels::{fitted_worse, split_within, stop_after_level};
-use super::quality::{SelfIntersections, assess};
+use super::quality::{CHECK_RATE, SelfIntersections, assess};
 use super::refine_marks::{face_residuals, faces_above_noise, faces_off_data};
 use super::sampling::{shuffled_order, surface_samples, trimmed_rms};
 use super::system::{LevelSystem, check_level_memory};
-use super::{ErrorStats, FitParams, FitReport, LevelReport, Refinement, ToleranceStat};
+use super::{ErrorStats, FitParams, FitReport, LevelReport, Refinement, ToleranceStat, Untangling};
 
 /// Taubin steps on the control points of the faces an untangling round
 /// marks (`FitParams::untangle_rounds`).
@@ -578,8 +578,10 @@ pub fn fit_screened_cloud(
         }
         mesh = next;
     };
+    let (crossings, final_untangling) =
+        untangle_after_fit(&mut mesh, params.final_untangle_rounds)?;
     let kept_dist: Vec<Real> = data_index.iter().map(|&i| final_dist[i]).collect();
-    let quality = assess(&mesh, &data, &data_tree, &kept_dist, diameter)?;
+    let quality = assess(&mesh, crossings, &data, &data_tree, &kept_dist, diameter)?;
     Ok(FitResult {
         control: mesh,
         report: FitReport {
@@ -591,6 +593,7 @@ pub fn fit_screened_cloud(
             levels,
             converged,
             stop_reason,
+            final_untangling,
             seconds: start.elapsed().as_secs_f64(),
         },
     })
@@ -609,12 +612,7 @@ fn untangled(
     umbrella: &mut [Real],
     stiffening: Real,
 ) -> Vec<Point3> {
-    let mut moving = vec![false; mesh.num_vertices()];
-    for f in (0..mesh.num_faces()).filter(|&f| crossing[f]) {
-        for &v in mesh.face(f) {
-            moving[v as usize] = true;
-        }
-    }
+    let moving = corners_of(mesh, crossing);
     for (v, r) in ring.iter().enumerate() {
         if moving[v] || r.iter().any(|&u| moving[u as usize]) {
             umbrella[v] *= stiffening;
@@ -626,6 +624,54 @@ fn untangled(
         face_vertices: mesh.face_vertices.clone(),
     };
     taubin_smoothed_where(&net, UNTANGLE_SMOOTHING_STEPS, &moving).positions
+}
+
+/// The untangling after the last level ([`FitParams::final_untangle_rounds`]):
+/// the control points of the faces whose limit surface crosses itself (at
+/// the assessment's rate, [`CHECK_RATE`]) get [`UNTANGLE_SMOOTHING_STEPS`]
+/// Taubin steps, without a refit, round after round while the crossing
+/// pairs get fewer; `mesh` keeps the best positions. Returns their
+/// self-intersections (for [`assess`]) and what was done.
+fn untangle_after_fit(
+    mesh: &mut PolyMesh,
+    max_rounds: usize,
+) -> Result<(SelfIntersections, Untangling)> {
+    let refiner = Refiner::new(mesh, &RefineOptions::default())?;
+    let start = mesh.positions.clone();
+    let mut best = SelfIntersections::of(&refiner, &start, CHECK_RATE)?;
+    let mut done = Untangling {
+        pairs_before: best.pairs.len(),
+        ..Default::default()
+    };
+    while !best.pairs.is_empty() && done.rounds < max_rounds {
+        let moving = corners_of(mesh, &best.faces(mesh.num_faces()));
+        let p = taubin_smoothed_where(mesh, UNTANGLE_SMOOTHING_STEPS, &moving).positions;
+        let next = best.moved(&refiner, &p)?;
+        done.rounds += 1;
+        if next.pairs.len() >= best.pairs.len() {
+            break;
+        }
+        mesh.positions = p;
+        best = next;
+    }
+    for (a, b) in start.iter().zip(&mesh.positions) {
+        if a != b {
+            done.moved_control_points += 1;
+            done.largest_move = done.largest_move.max((a - b).norm());
+        }
+    }
+    Ok((best, done))
+}
+
+/// The corners of the faces marked in `faces`, as a mask over the vertices.
+fn corners_of(mesh: &PolyMesh, faces: &[bool]) -> Vec<bool> {
+    let mut out = vec![false; mesh.num_vertices()];
+    for f in (0..mesh.num_faces()).filter(|&f| faces[f]) {
+        for &v in mesh.face(f) {
+            out[v as usize] = true;
+        }
+    }
+    out
 }
 
 /// For every query, the closest-point answer (patch and `(s, t)`) of its

@@ -18,5 +18,5 @@ mod system;
 
 pub use driver::{FitResult, fit_point_cloud, fit_screened_cloud};
 pub use params::{FitParams, Refinement, ToleranceStat};
-pub use report::{ErrorStats, FitReport, LevelReport};
+pub use report::{ErrorStats, FitReport, LevelReport, Untangling};
 pub use start::{FitRun, FitStart, MIN_FIT_POINTS, fit_from_start, stat_name};

@@ -22,7 +22,9 @@
 //!   `is_self_intersecting()`: pleats and pinches where the surface passes
 //!   through itself without turning over at any one triangle. The fit
 //!   stiffens and refits the faces they come from
-//!   ([`FitParams::untangle_rounds`](super::FitParams::untangle_rounds));
+//!   ([`FitParams::untangle_rounds`](super::FitParams::untangle_rounds)),
+//!   smooths them once more after the last level
+//!   ([`FitParams::final_untangle_rounds`](super::FitParams::final_untangle_rounds));
 //!   what is left is reported.
 //!
 //! - **Tangled control faces**: faces of the control mesh that fold over in
@@ -33,6 +35,8 @@
 //! the size and where (the bounding box of the largest connected far
 //! region, or of the points), printed by `subdyn fit` and kept in the report.
 
+use std::sync::Arc;
+
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -42,7 +46,7 @@ use crate::limit::tessellate;
 use crate::math::{Point3, Real, Vector3, bounding_box, polygon_folds};
 use crate::mesh::PolyMesh;
 use crate::metrics::TriangleBvh;
-use crate::subdivision::{RefineOptions, Refiner};
+use crate::subdivision::Refiner;
 use crate::topology::{UnionFind, face_of_corner};
 
 /// Samples per side of every tessellation tile [`assess`] checks (the
@@ -112,20 +116,20 @@ pub struct FitQuality {
     pub warnings: Vec<String>,
 }
 
-/// Assesses the limit surface of `control` against the screened `data`
-/// points (`data_tree` over them), whose distances to the surface are
-/// `distance`; `diameter` is the data's bounding-box diagonal.
+/// Assesses the limit surface of `control`, whose tessellation at
+/// [`CHECK_RATE`] and self-intersections are `sx`, against the screened
+/// `data` points (`data_tree` over them), whose distances to the surface
+/// are `distance`; `diameter` is the data's bounding-box diagonal.
 pub fn assess(
     control: &PolyMesh,
+    sx: SelfIntersections,
     data: &[Point3],
     data_tree: &ImmutableKdTree<Real, 3>,
     distance: &[Real],
     diameter: Real,
 ) -> Result<FitQuality> {
     let far = FAR_PCT / 100.0 * diameter;
-    let refiner = Refiner::new(control, &RefineOptions::default())?;
-    let sx = SelfIntersections::of(&refiner, &control.positions, CHECK_RATE)?;
-    let (tris, p, normals) = (&sx.triangles, &sx.positions, &sx.normals);
+    let (tris, p, normals) = (sx.triangles(), &sx.positions, &sx.normals);
     // Per triangle: area, far from the data, folded.
     let facts: Vec<(Real, bool, bool)> = tris
         .par_iter()
@@ -231,12 +235,13 @@ pub struct SelfIntersections {
     pub positions: Vec<Point3>,
     /// Limit normals at them.
     pub normals: Vec<Vector3>,
-    /// Tessellation triangles.
-    pub triangles: Vec<[u32; 3]>,
     /// The control face each triangle lies on.
     pub face: Vec<u32>,
-    /// Intersecting pairs (indices into `triangles`).
+    /// Intersecting pairs (indices into [`triangles`](Self::triangles)).
     pub pairs: Vec<[u32; 2]>,
+    /// The first check ([`of`](Self::of)): its hierarchy, pairs and rate,
+    /// which [`moved`](Self::moved) updates.
+    first: Arc<(TriangleBvh, Vec<[u32; 2]>, usize)>,
 }
 
 impl SelfIntersections {
@@ -270,10 +275,31 @@ impl SelfIntersections {
         Ok(SelfIntersections {
             positions: bvh.positions().to_vec(),
             normals,
-            triangles: bvh.triangles().to_vec(),
             face,
-            pairs,
+            pairs: pairs.clone(),
+            first: Arc::new((bvh, pairs, rate)),
         })
+    }
+
+    /// The same check after the control points moved to `positions`: the
+    /// pairs [`of`](Self::of) would give, found by testing again only the
+    /// tessellation triangles that moved
+    /// ([`TriangleBvh::self_intersections_moved`]).
+    pub fn moved(&self, refiner: &Refiner, positions: &[Point3]) -> Result<Self> {
+        let (bvh, pairs, rate) = &*self.first;
+        let (mesh, normals) = tessellate(refiner, positions, *rate)?;
+        Ok(SelfIntersections {
+            pairs: bvh.self_intersections_moved(pairs, &mesh.positions)?,
+            positions: mesh.positions,
+            normals,
+            face: self.face.clone(),
+            first: self.first.clone(),
+        })
+    }
+
+    /// Tessellation triangles (indices into `positions`).
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        self.first.0.triangles()
     }
 
     /// Per control face of the mesh (`num_faces` of them): whether a

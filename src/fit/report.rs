@@ -116,6 +116,23 @@ pub struct LevelReport {
     pub refinement: String,
 }
 
+/// What the untangling after the last level did. The levels' error
+/// statistics were measured before it; the control points it moved are
+/// few, and `largest_move` bounds how far any moved.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Untangling {
+    /// Self-intersecting tessellation pairs before it (at
+    /// [`CHECK_RATE`](super::quality::CHECK_RATE)).
+    pub pairs_before: usize,
+    /// Smoothing rounds tried (the last one is undone when it did not
+    /// lower the pairs).
+    pub rounds: usize,
+    /// Control points moved.
+    pub moved_control_points: usize,
+    /// The largest move of a control point (length units).
+    pub largest_move: Real,
+}
+
 /// The whole fit.
 #[derive(Clone, Debug, Serialize)]
 pub struct FitReport {
@@ -135,6 +152,9 @@ pub struct FitReport {
     pub converged: bool,
     /// Why the fit stopped.
     pub stop_reason: String,
+    /// The untangling after the last level
+    /// ([`FitParams::final_untangle_rounds`](super::FitParams::final_untangle_rounds)).
+    pub final_untangling: Untangling,
     /// Total wall time, seconds.
     pub seconds: Real,
     /// What the result itself shows: surface far from the data, points far

@@ -14,6 +14,7 @@
 
 use rayon::prelude::*;
 
+use crate::error::{Error, Result};
 use crate::math::{Point3, Real, Vector3};
 
 use super::bvh::{STACK, TriangleBvh};
@@ -150,6 +151,114 @@ impl TriangleBvh {
         pairs.sort_unstable();
         pairs.dedup();
         pairs
+    }
+
+    /// [`self_intersections`](Self::self_intersections) of this hierarchy's
+    /// triangles with their vertices at `positions` instead (the same
+    /// vertices, some of them moved), given the pairs `pairs` at the
+    /// hierarchy's own positions. Only the triangles with a moved vertex are
+    /// tested again, against each other, against the others (through this
+    /// hierarchy, where the others still are) and the others' edges against
+    /// them, so a local change costs about its own size; each test is the
+    /// one the full search makes, so the pairs are the same.
+    pub fn self_intersections_moved(
+        &self,
+        pairs: &[[u32; 2]],
+        positions: &[Point3],
+    ) -> Result<Vec<[u32; 2]>> {
+        let tris = self.triangles();
+        if positions.len() != self.positions().len() {
+            return Err(Error::Input(format!(
+                "{} positions for a hierarchy over {} vertices",
+                positions.len(),
+                self.positions().len()
+            )));
+        }
+        let moved: Vec<bool> = self
+            .positions()
+            .iter()
+            .zip(positions)
+            .map(|(a, b)| a != b)
+            .collect();
+        let changed: Vec<bool> = tris
+            .iter()
+            .map(|t| t.iter().any(|&v| moved[v as usize]))
+            .collect();
+        let ids: Vec<u32> = (0..tris.len() as u32)
+            .filter(|&t| changed[t as usize])
+            .collect();
+        let mut out: Vec<[u32; 2]> = pairs
+            .iter()
+            .filter(|p| !changed[p[0] as usize] && !changed[p[1] as usize])
+            .copied()
+            .collect();
+        if ids.is_empty() {
+            return Ok(out);
+        }
+        let moved_tris = TriangleBvh::new(
+            positions.to_vec(),
+            ids.iter().map(|&t| tris[t as usize]).collect(),
+        )?;
+        let pair = |s: u32, t: u32| [s.min(t), s.max(t)];
+        out.extend(
+            moved_tris
+                .self_intersections()
+                .into_iter()
+                .map(|[a, b]| pair(ids[a as usize], ids[b as usize])),
+        );
+        // An edge from its lower vertex index, as the full search takes it.
+        let edge = |t: &[u32; 3], e: usize| {
+            let (a, b) = (t[e].min(t[(e + 1) % 3]), t[e].max(t[(e + 1) % 3]));
+            (positions[a as usize], positions[b as usize])
+        };
+        let shares = |s: &[u32; 3], t: &[u32; 3]| s.iter().any(|v| t.contains(v));
+        // Moved edges against the triangles that stayed.
+        out.par_extend(ids.par_iter().flat_map_iter(|&s| {
+            let ts = &tris[s as usize];
+            let mut hits = Vec::new();
+            for e in 0..3 {
+                let (a, b) = edge(ts, e);
+                self.segment_hits(a, b, &mut hits);
+            }
+            hits.into_iter()
+                .filter(|&t| !changed[t] && !shares(ts, &tris[t]))
+                .map(move |t| pair(s, t as u32))
+        }));
+        // Edges of the triangles that stayed against the moved ones, for the
+        // triangles near them.
+        let margin = 1e-9 * self.extent.max(Real::MIN_POSITIVE);
+        let (mut lo, mut hi) = ([Real::INFINITY; 3], [Real::NEG_INFINITY; 3]);
+        for &t in &ids {
+            for &v in &tris[t as usize] {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(positions[v as usize][k] - margin);
+                    hi[k] = hi[k].max(positions[v as usize][k] + margin);
+                }
+            }
+        }
+        out.par_extend((0..tris.len() as u32).into_par_iter().flat_map_iter(|t| {
+            let tt = &tris[t as usize];
+            let near = !changed[t as usize]
+                && (0..3).all(|k| {
+                    let c = tt.map(|v| positions[v as usize][k]);
+                    c.iter().copied().fold(Real::INFINITY, Real::min) <= hi[k]
+                        && c.iter().copied().fold(Real::NEG_INFINITY, Real::max) >= lo[k]
+                });
+            let mut hits = Vec::new();
+            if near {
+                for e in 0..3 {
+                    let (a, b) = edge(tt, e);
+                    moved_tris.segment_hits(a, b, &mut hits);
+                }
+            }
+            hits.into_iter()
+                .map(|l| ids[l])
+                .filter(|&s| !shares(tt, &tris[s as usize]))
+                .map(move |s| pair(s, t))
+        }));
+        out.sort_unstable();
+        out.dedup();
+        Ok(out)
     }
 
     /// Appends to `out` every leaf slot whose leaf box overlaps the box
