@@ -1074,3 +1074,149 @@ fn subdivide_reads_opensubdiv_tags_and_leaves_holes_out() {
     );
     assert!(!dir.path().join("b.obj").exists());
 }
+
+/// Every file under `dir`, recursively, as `/`-separated paths relative to `dir`.
+fn tree(dir: &Path) -> Vec<String> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<String>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                walk(root, &path, out);
+            } else {
+                let rel = path.strip_prefix(root).unwrap();
+                out.push(rel.to_string_lossy().replace('\\', "/"));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
+
+/// Runs `args` in `dir`, asserts success, and that the `wrote <path> (<what>)`
+/// lines at the end of stdout name exactly the files the run added.
+fn names_every_written_file(dir: &Path, args: &[&str]) -> String {
+    let before = tree(dir);
+    let out = ok(&run_subdyn(dir, args));
+    let added: Vec<String> = tree(dir)
+        .into_iter()
+        .filter(|f| !before.contains(f))
+        .collect();
+    assert!(!added.is_empty(), "{args:?} wrote nothing");
+    let named: Vec<String> = out
+        .lines()
+        .filter_map(|l| l.strip_prefix("wrote "))
+        .map(|l| {
+            let (path, what) = l.split_once(" (").expect("wrote <path> (<what>)");
+            assert!(what.ends_with(')') && what.len() > 1, "{args:?}: {l}");
+            path.to_string()
+        })
+        .collect();
+    let mut sorted = named.clone();
+    sorted.sort();
+    assert_eq!(sorted, added, "{args:?} named these files:\n{out}");
+    // The list closes the output: nothing after the first `wrote` line but more of them.
+    let tail: Vec<&str> = out
+        .lines()
+        .skip_while(|l| !l.starts_with("wrote "))
+        .collect();
+    assert_eq!(tail.len(), named.len(), "{args:?}:\n{out}");
+    out
+}
+
+#[test]
+fn every_verb_names_every_file_it_wrote() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    copy(d, "opensubdiv/cube.obj", "cube.obj");
+    names_every_written_file(d, &["subdivide", "-o", "s.obj", "--report", "s.json"]);
+    names_every_written_file(
+        d,
+        &["limit", "cube.obj", "-o", "l.ply", "--report", "l.json"],
+    );
+    let out = names_every_written_file(
+        d,
+        &[
+            "lattice", "cube.obj", "-o", "lat.json", "--report", "lr.json",
+        ],
+    );
+    assert!(out.contains("wrote lat.json (lattice)\n"), "{out}");
+    write(
+        d,
+        "moves.json",
+        br#"{"moves": [{"vertex": 0, "offset": [0, 0, -0.2]}]}"#,
+    );
+    names_every_written_file(
+        d,
+        &[
+            "ffd",
+            "cube.obj",
+            "--lattice",
+            "lat.json",
+            "--moves",
+            "moves.json",
+            "-o",
+            "f.obj",
+            "--report",
+            "fr.json",
+            "--quiet",
+        ],
+    );
+    names_every_written_file(
+        d,
+        &[
+            "compare",
+            "f.obj",
+            "cube.obj",
+            "--report",
+            "cr.json",
+            "--distances-out",
+            "cd.txt",
+        ],
+    );
+    names_every_written_file(d, &["render", "f.obj", "-o", "f.png", "--size", "64,48"]);
+    write(
+        d,
+        "ops.json",
+        br#"{"dt": 0.005, "steps": 20, "ops": [{"step": 0, "op": "fix", "points": [0]}]}"#,
+    );
+    let out = names_every_written_file(
+        d,
+        &[
+            "sculpt",
+            "lat.json",
+            "--level",
+            "1",
+            "--script",
+            "ops.json",
+            "--out-dir",
+            "frames",
+            "--every",
+            "10",
+        ],
+    );
+    assert!(
+        out.contains("wrote frames/frame_0000020.obj (frame, step 20)\n"),
+        "{out}"
+    );
+    write(d, "sphere.xyz", sphere_xyz(800).as_bytes());
+    names_every_written_file(
+        d,
+        &[
+            "fit",
+            "sphere.xyz",
+            "-o",
+            "fit.obj",
+            "--max-level",
+            "1",
+            "--report",
+            "fit.json",
+            "--plot",
+            "fit.png",
+            "--limit-out",
+            "fit_limit.ply",
+            "--quiet",
+        ],
+    );
+}

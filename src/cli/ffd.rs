@@ -18,7 +18,7 @@ use subdyn::lattice::MAX_LATTICE_LEVELS;
 use subdyn::math::{Point3, Vector3};
 
 use super::common::{
-    about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, write_report,
+    Written, about_file, check_mesh_output, check_output_dir, seconds, thousands, write_report,
 };
 use super::options::read_polygon_mesh;
 use super::progress::Progress;
@@ -162,6 +162,8 @@ pub fn run(args: &FfdArgs) -> anyhow::Result<()> {
     progress.stage(format!("writing {}", args.output.display()));
     write_mesh(&args.output, &out, None).map_err(|e| about_file(e, &args.output))?;
     drop(progress);
+    let mut written = Written::new();
+    written.add(&args.output, "deformed mesh");
     let r = &ffd.report;
     if r.outside > 0 && !args.quiet {
         super::common::warn(
@@ -185,9 +187,10 @@ pub fn run(args: &FfdArgs) -> anyhow::Result<()> {
             "timings_s": {"refine": r.refine_s, "embed": r.embed_s, "deform": deform_s, "total": seconds(start)},
         });
         write_report(report, &value)?;
+        written.add(report, "report");
     }
-    print_stdout(&format!(
-        "deformed {} of {} vertices of {} with {} ({} cells, {} levels → {} cells); {} outside; written to {}\n",
+    written.print_after(&format!(
+        "deformed {} of {} vertices of {} with {} ({} cells, {} levels → {} cells); {} outside\n",
         thousands(r.embedded),
         thousands(r.points),
         args.model.display(),
@@ -196,6 +199,5 @@ pub fn run(args: &FfdArgs) -> anyhow::Result<()> {
         args.levels,
         thousands(r.level_cells),
         thousands(r.outside),
-        args.output.display()
     ))
 }

@@ -13,7 +13,7 @@ use subdyn::lattice::{
     BoxKind, BoxLatticeParams, box_lattice, locally_refined, shrunk_box_lattice,
 };
 
-use super::common::{about_file, check_output_dir, print_stdout, thousands, write_report};
+use super::common::{Written, about_file, check_output_dir, thousands, write_report};
 
 /// Box orientation on the command line.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -102,6 +102,8 @@ pub fn run(args: &LatticeArgs) -> anyhow::Result<()> {
         (lat, Some(r))
     };
     write_lattice(&args.output, &lat).map_err(|e| about_file(e, &args.output))?;
+    let mut written = Written::new();
+    written.add(&args.output, "lattice");
     if let Some(report) = &args.report {
         write_report(
             report,
@@ -117,6 +119,7 @@ pub fn run(args: &LatticeArgs) -> anyhow::Result<()> {
                 "local_refinement": local,
             }),
         )?;
+        written.add(report, "report");
     }
     let mut extra = String::new();
     if let Some(r) = &shrink {
@@ -131,13 +134,12 @@ pub fn run(args: &LatticeArgs) -> anyhow::Result<()> {
             r.refined, r.non_hexahedral
         );
     }
-    print_stdout(&format!(
-        "lattice around {} ({} vertices): {} control points, {} cells (of {} before culling){extra}, written to {}\n",
+    written.print_after(&format!(
+        "lattice around {} ({} vertices): {} control points, {} cells (of {} before culling){extra}\n",
         args.model.display(),
         thousands(mesh.num_vertices()),
         thousands(lat.num_vertices()),
         thousands(lat.topology.num_cells()),
         thousands(1usize << (3 * args.octree_levels)),
-        args.output.display()
     ))
 }

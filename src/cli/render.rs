@@ -16,7 +16,7 @@ use subdyn::render::{
     render, write_png,
 };
 
-use super::common::{about_file, print_stdout, thousands};
+use super::common::{Written, about_file, thousands};
 use super::options::RefineArgs;
 use super::progress::Progress;
 
@@ -189,12 +189,14 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     progress.stage(format!("writing {}", args.output.display()));
     write_png(&args.output, &picture).map_err(|e| about_file(e, &args.output))?;
     drop(progress);
-    print_stdout(&format!(
-        "rendered {name} ({}) to {} ({}×{})\n",
+    let mut written = Written::new();
+    written.add(
+        &args.output,
+        format!("picture, {}×{}", picture.width(), picture.height()),
+    );
+    written.print_after(&format!(
+        "rendered {name} ({})\n",
         describe(surface, cloud.as_ref(), extra.as_ref()),
-        args.output.display(),
-        picture.width(),
-        picture.height()
     ))
 }
 

@@ -53,7 +53,7 @@ use subdyn::math::{Point3, Real};
 use subdyn::mesh::PolyMesh;
 use subdyn::solid::{MAX_SOLID_LEVEL, Solid, Stiffness};
 
-use super::common::{about_file, print_stdout, seconds, write_report};
+use super::common::{Written, about_file, seconds, write_report};
 use super::progress::Progress;
 use super::sculpt_script::{
     MAX_STEPS, Op, Script, nearest_centroid, parse_script, read_script, selection, solid_params,
@@ -192,9 +192,18 @@ pub fn run(args: &SculptArgs) -> anyhow::Result<()> {
         "ops": ops,
         "frames": frames,
     });
-    write_report(&args.out_dir.join("log.json"), &log)?;
-    let mut text = format!(
-        "subdyn sculpt: {name}, level {}, {} steps of {} s ({:?}), {} → {} mass points, {:.3} ms per step; {} frames and log.json in {}\n",
+    let mut written = Written::new();
+    for frame in &frames {
+        if let Some(step) = frame["step"].as_u64() {
+            let path = frame_path(&args.out_dir, step as usize);
+            written.add(&path, format!("frame, step {step}"));
+        }
+    }
+    let log_path = args.out_dir.join("log.json");
+    write_report(&log_path, &log)?;
+    written.add(&log_path, "log");
+    let text = format!(
+        "subdyn sculpt: {name}, level {}, {} steps of {} s ({:?}), {} → {} mass points, {:.3} ms per step; {} frames\n",
         args.level,
         script.steps,
         script.dt,
@@ -203,14 +212,13 @@ pub fn run(args: &SculptArgs) -> anyhow::Result<()> {
         solid.mass_points().len(),
         mean_ms,
         frames.len(),
-        args.out_dir.display()
     );
     if args.demo {
         let path = args.out_dir.join("sculpt_demo.png");
         super::sculpt_demo::write_strip(&snapshots, &path)?;
-        text.push_str(&format!("picture: {}\n", path.display()));
+        written.add(&path, "key frames picture");
     }
-    print_stdout(&text)
+    written.print_after(&text)
 }
 
 type SessionOutput = (Vec<Value>, Vec<Value>, Vec<Snapshot>, Vec<Real>);
