@@ -1220,3 +1220,57 @@ fn every_verb_names_every_file_it_wrote() {
         ],
     );
 }
+
+#[test]
+fn a_lattice_can_be_inspected_listed_and_its_moves_format_is_in_the_help() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    copy(d, "opensubdiv/cube.obj", "cube.obj");
+    let out = ok(&run_subdyn(
+        d,
+        &[
+            "lattice",
+            "cube.obj",
+            "--octree-levels",
+            "1",
+            "-o",
+            "lat.json",
+            "--list-vertices",
+        ],
+    ));
+    let rows: Vec<Vec<f64>> = out
+        .lines()
+        .skip_while(|l| !l.trim_start().starts_with("vertex"))
+        .skip(1)
+        .take_while(|l| !l.starts_with("wrote "))
+        .map(|l| l.split_whitespace().map(|t| t.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 27, "{out}");
+    let lattice = subdyn::io::read_lattice(d.join("lat.json")).unwrap();
+    for (i, row) in rows.iter().enumerate() {
+        assert_eq!(row[0], i as f64);
+        let p = lattice.positions[i];
+        assert!((row[1] - p.x).abs() + (row[2] - p.y).abs() + (row[3] - p.z).abs() < 1e-5);
+    }
+
+    let text = ok(&run_subdyn(d, &["info", "lat.json"]));
+    assert!(text.contains("control points:       27"), "{text}");
+    assert!(
+        text.contains("cells:                8 (8 hexahedra)"),
+        "{text}"
+    );
+    let json: Value =
+        serde_json::from_str(&ok(&run_subdyn(d, &["info", "lat.json", "--json"]))).unwrap();
+    assert_eq!(json["kind"], "lattice");
+    assert_eq!(json["control_points"], 27);
+    assert_eq!(json["faces"], 36);
+    assert_eq!(json["boundary_faces"], 24);
+
+    let help = ok(&run_subdyn(d, &["ffd", "--help"]));
+    assert!(!help.contains("see `subdyn ffd --help`"), "{help}");
+    assert!(
+        help.contains(r#"{"vertex": 7, "position": [1, 2, 3]}"#),
+        "{help}"
+    );
+    assert!(help.contains("--list-vertices"), "{help}");
+}

@@ -25,6 +25,7 @@ use super::progress::Progress;
 
 /// Arguments of `subdyn ffd`.
 #[derive(Debug, Args)]
+#[command(after_help = MOVES_HELP)]
 pub struct FfdArgs {
     /// The model to deform (.obj, .ply, .off).
     #[arg(value_name = "MODEL")]
@@ -40,7 +41,7 @@ pub struct FfdArgs {
         required_unless_present = "moves"
     )]
     pub deformed: Option<PathBuf>,
-    /// Control-point moves (JSON, see `subdyn ffd --help`).
+    /// Control-point moves (JSON: {"moves": [{"vertex": 3, "offset": [0, 0, 0.5]}, …]}; format below).
     #[arg(long, value_name = "MOVES.json")]
     pub moves: Option<PathBuf>,
     /// Refinement levels of the lattice (1 to 6).
@@ -56,6 +57,14 @@ pub struct FfdArgs {
     #[arg(short, long)]
     pub quiet: bool,
 }
+
+/// The `--moves` format, shown by `subdyn ffd --help`.
+const MOVES_HELP: &str = "MOVES.json lists control points of the lattice to move:
+  {\"moves\": [{\"vertex\": 3, \"offset\": [0, 0, 0.5]}, {\"vertex\": 7, \"position\": [1, 2, 3]}]}
+Each move names a control point by its number (its place in the lattice file's \"vertices\", from 0)
+and gives exactly one of \"offset\" (added to its rest position) or \"position\" (where it goes).
+`subdyn lattice MODEL -o LAT.json --list-vertices` prints the numbers and positions;
+`subdyn render LAT.json -o LAT.png --label-vertices` draws them.";
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -58,6 +58,20 @@ pub struct LatticeArgs {
     /// Write a JSON report.
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
+    /// Also print every control point: its number (the `"vertex"` of
+    /// `subdyn ffd --moves`) and its position. `subdyn render LAT.json
+    /// --label-vertices` shows the numbers in a picture.
+    #[arg(long)]
+    pub list_vertices: bool,
+}
+
+/// `vertex x y z` lines, one per control point, numbered from 0.
+fn vertex_table(positions: &[subdyn::math::Point3]) -> String {
+    let mut s = format!("{:>6}  {:>12}  {:>12}  {:>12}\n", "vertex", "x", "y", "z");
+    for (i, p) in positions.iter().enumerate() {
+        s += &format!("{i:>6}  {:>12.6}  {:>12.6}  {:>12.6}\n", p.x, p.y, p.z);
+    }
+    s
 }
 
 /// Runs `subdyn lattice`.
@@ -133,6 +147,9 @@ pub fn run(args: &LatticeArgs) -> anyhow::Result<()> {
             "; {} cells refined locally, {} non-hexahedral cells",
             r.refined, r.non_hexahedral
         );
+    }
+    if args.list_vertices {
+        extra += &format!("\n{}", vertex_table(&lat.positions).trim_end());
     }
     written.print_after(&format!(
         "lattice around {} ({} vertices): {} control points, {} cells (of {} before culling){extra}\n",
