@@ -3,6 +3,7 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, PoisonError};
 use std::time::Instant;
 
 use anyhow::Context;
@@ -135,10 +136,25 @@ impl Written {
             .collect()
     }
 
-    /// Prints `text` then [`Written::lines`] on stdout.
+    /// Prints `text` then [`Written::lines`] on stdout once the run's files
+    /// are in place: the text waits for [`print_pending`], which the command
+    /// line calls after renaming the staged outputs, so no `wrote` line names
+    /// a file that a failed commit left out.
     pub fn print_after(&self, text: &str) -> anyhow::Result<()> {
-        print_stdout(&format!("{text}{}", self.lines()))
+        let mut pending = PENDING.lock().unwrap_or_else(PoisonError::into_inner);
+        pending.push_str(text);
+        pending.push_str(&self.lines());
+        Ok(())
     }
+}
+
+/// What [`Written::print_after`] holds back until the outputs are committed.
+static PENDING: Mutex<String> = Mutex::new(String::new());
+
+/// Prints (and forgets) what [`Written::print_after`] held back.
+pub fn print_pending() -> anyhow::Result<()> {
+    let text = std::mem::take(&mut *PENDING.lock().unwrap_or_else(PoisonError::into_inner));
+    print_stdout(&text)
 }
 
 /// Prints a warning line on stderr unless `quiet`.
