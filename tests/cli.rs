@@ -1274,3 +1274,58 @@ fn a_lattice_can_be_inspected_listed_and_its_moves_format_is_in_the_help() {
     );
     assert!(help.contains("--list-vertices"), "{help}");
 }
+
+/// The examples of `docs/formats.md` are read by the verbs they document.
+#[test]
+fn the_examples_of_the_formats_page_are_read() {
+    let page =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/formats.md"))
+            .unwrap();
+    let blocks = |lang: &str| -> Vec<String> {
+        page.split(&format!("```{lang}\n"))
+            .skip(1)
+            .map(|b| b.split("```").next().unwrap().to_string())
+            .collect()
+    };
+    let (json, text) = (blocks("json"), blocks("text"));
+    assert!(
+        json.len() >= 3 && !text.is_empty(),
+        "code blocks of formats.md"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    copy(d, "opensubdiv/cube.obj", "cube.obj");
+    write(d, "c.creases", text[0].as_bytes());
+    ok(&run_subdyn(
+        d,
+        &[
+            "subdivide",
+            "cube.obj",
+            "--creases",
+            "c.creases",
+            "-o",
+            "s.obj",
+        ],
+    ));
+    write(d, "lat.json", json[0].as_bytes());
+    write(d, "moves.json", json[1].as_bytes());
+    let info: Value =
+        serde_json::from_str(&ok(&run_subdyn(d, &["info", "lat.json", "--json"]))).unwrap();
+    assert_eq!(info["control_points"], 8);
+    let out = ok(&run_subdyn(
+        d,
+        &[
+            "ffd",
+            "cube.obj",
+            "--lattice",
+            "lat.json",
+            "--moves",
+            "moves.json",
+            "-o",
+            "f.obj",
+        ],
+    ));
+    assert!(out.contains("wrote f.obj (deformed mesh)"), "{out}");
+    let sidecar: Value = serde_json::from_str(&json[2]).expect("the sidecar example is JSON");
+    assert_eq!(sidecar["dims"], serde_json::json!([128, 128, 96]));
+}
