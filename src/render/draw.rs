@@ -120,7 +120,7 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Picture> {
     }
 
     let mut picture = downsample(&target, k)?;
-    let label_scale = (text_scale / 2).max(1);
+    let label_scale = text_scale;
     for label in &scene.labels {
         let p = camera.project(&label.at);
         if p.x.is_finite() && p.y.is_finite() && p.x.abs() < 1e6 && p.y.abs() < 1e6 {
