@@ -1329,3 +1329,27 @@ fn the_examples_of_the_formats_page_are_read() {
     let sidecar: Value = serde_json::from_str(&json[2]).expect("the sidecar example is JSON");
     assert_eq!(sidecar["dims"], serde_json::json!([128, 128, 96]));
 }
+
+#[test]
+fn a_json_file_that_is_no_lattice_is_refused_with_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "ops.json", br#"{"dt": 0.01, "steps": 10}"#);
+    let out = run_subdyn(d, &["info", "ops.json"]);
+    assert_clean_failure(
+        d,
+        &out,
+        &["ops.json", "neither lattice JSON"],
+        &["ops.json"],
+    );
+    let out = run_subdyn(d, &["render", "ops.json", "-o", "o.png"]);
+    assert_clean_failure(d, &out, &["ops.json", "not lattice JSON"], &["ops.json"]);
+    // A broken lattice names the file and the element.
+    write(
+        d,
+        "bad.json",
+        br#"{"vertices": [[0, 0, 0]], "hexahedra": [[0, 0, 0, 0, 0, 0, 0, 0]]}"#,
+    );
+    let out = run_subdyn(d, &["render", "bad.json", "-o", "o.png"]);
+    assert_clean_failure(d, &out, &["bad.json", "face 0"], &["bad.json", "ops.json"]);
+}

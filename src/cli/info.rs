@@ -34,6 +34,12 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     if subdyn::io::is_lattice_file(path) {
         return super::info_lattice::run(path, args.json);
     }
+    if super::render::is_json(path) && !has_dims(path) {
+        anyhow::bail!(
+            "{}: neither lattice JSON (an object with a \"vertices\" list) nor a volume header (with \"dims\")",
+            path.display()
+        );
+    }
     if super::info_volume::is_volume(path) {
         return super::info_volume::run(path, args.json);
     }
@@ -82,6 +88,16 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
         }
     };
     print_stdout(&text)
+}
+
+/// Whether the JSON file at `path` is an object with a `"dims"` field (a
+/// volume header); unreadable or invalid JSON counts as yes, so that the
+/// volume reader names the problem.
+fn has_dims(path: &Path) -> bool {
+    subdyn::io::read_input(path)
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        .is_none_or(|v| v.get("dims").is_some())
 }
 
 fn json_line(value: &serde_json::Value) -> String {

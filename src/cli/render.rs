@@ -111,6 +111,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if subdyn::io::is_lattice_file(&args.input) {
         return super::render_lattice::run(args, options);
     }
+    if is_json(&args.input) {
+        anyhow::bail!(
+            "{}: not lattice JSON (an object with a \"vertices\" list); render draws .obj, .ply, .off and .xyz files and lattices",
+            args.input.display()
+        );
+    }
     let progress = Progress::new(args.quiet);
     let name = args.input.display().to_string();
 
@@ -213,6 +219,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         "rendered {name} ({})\n",
         describe(surface, cloud.as_ref(), extra.as_ref()),
     ))
+}
+
+/// Whether `path` ends in `.json`.
+pub fn is_json(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
 }
 
 /// Labels with the vertex numbers of `positions` (at most [`MAX_LABELS`]);
