@@ -199,10 +199,10 @@ fn check_op(op: &Op, step: usize, steps: usize) -> anyhow::Result<()> {
             finite("at", at)?;
             finite("to", to)?;
             if let Some(s) = stiffness {
-                check_value("stiffness", *s, true)?;
+                check_value("stiffness", *s, true).map_err(plain)?;
             }
             if let Some(r) = rest_length {
-                check_value("rest_length", *r, false)?;
+                check_value("rest_length", *r, false).map_err(plain)?;
             }
             if let Some(u) = until
                 && !(step..=steps).contains(u)
@@ -230,13 +230,13 @@ fn check_op(op: &Op, step: usize, steps: usize) -> anyhow::Result<()> {
                 bail!("give \"normal\" and/or \"virtual\"");
             }
             if let Some(k) = normal {
-                check_value("normal", *k, false)?;
+                check_value("normal", *k, false).map_err(plain)?;
             }
             if let Some(k) = virtual_ {
-                check_value("virtual", *k, false)?;
+                check_value("virtual", *k, false).map_err(plain)?;
             }
         }
-        Op::Damping { value } => check_value("value", *value, false)?,
+        Op::Damping { value } => check_value("value", *value, false).map_err(plain)?,
         Op::Release | Op::Plastic { .. } => {}
     }
     Ok(())
@@ -256,6 +256,7 @@ pub fn check_script(
 ) -> anyhow::Result<()> {
     solid_params(level, &script.material)
         .check()
+        .map_err(plain)
         .with_context(|| format!("{what}: material"))?;
     let mut lat = lattice.clone();
     for op in &script.ops {
@@ -270,11 +271,11 @@ fn edited(lat: Lattice, op: &Op) -> anyhow::Result<Lattice> {
     Ok(match op {
         Op::Extrude { face, near } => {
             let f = extruded_face(&lat, *face, near)?;
-            extrude_face(&lat, f)?
+            extrude_face(&lat, f).map_err(plain)?
         }
         Op::Trim { cell, near } => {
             let c = trimmed_cell(&lat, *cell, near)?;
-            trim_cell(&lat, c)?
+            trim_cell(&lat, c).map_err(plain)?
         }
         Op::Fix { points, bbox } | Op::Free { points, bbox } => {
             let n = lat.num_vertices();
@@ -300,7 +301,7 @@ pub fn extruded_face(
     let t = &lat.topology;
     match (face, near) {
         (Some(f), _) => {
-            extruded_topology(t, f)?;
+            extruded_topology(t, f).map_err(plain)?;
             Ok(f)
         }
         (None, Some(q)) => nearest_centroid(
@@ -332,6 +333,15 @@ pub fn trimmed_cell(
         )
         .ok_or_else(|| anyhow::anyhow!("the lattice has no cell")),
         (None, None) => bail!("trim needs \"cell\" or \"near\""),
+    }
+}
+
+/// A library error in the script's words: an input error's message without
+/// its `input:` prefix (the op is already named in front of it).
+fn plain(e: subdyn::Error) -> anyhow::Error {
+    match e {
+        subdyn::Error::Input(message) => anyhow::anyhow!(message),
+        e => anyhow::Error::new(e),
     }
 }
 
