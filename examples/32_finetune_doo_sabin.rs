@@ -82,7 +82,7 @@ fn main() -> subdyn::Result<()> {
             MeshLayer::new(&after).with_scalars(&moved),
             MeshLayer::wireframe(&cage1, wire),
         ],
-        clouds: Vec::new(),
+        ..Scene::default()
     };
     let options = RenderOptions {
         width: 900,

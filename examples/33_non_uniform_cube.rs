@@ -52,7 +52,7 @@ fn main() -> subdyn::Result<()> {
     }
     let scene = Scene {
         meshes: surfaces.iter().map(MeshLayer::new).collect(),
-        clouds: Vec::new(),
+        ..Scene::default()
     };
     let options = RenderOptions {
         width: 900,

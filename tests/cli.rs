@@ -1074,3 +1074,282 @@ fn subdivide_reads_opensubdiv_tags_and_leaves_holes_out() {
     );
     assert!(!dir.path().join("b.obj").exists());
 }
+
+/// Every file under `dir`, recursively, as `/`-separated paths relative to `dir`.
+fn tree(dir: &Path) -> Vec<String> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<String>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                walk(root, &path, out);
+            } else {
+                let rel = path.strip_prefix(root).unwrap();
+                out.push(rel.to_string_lossy().replace('\\', "/"));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
+
+/// Runs `args` in `dir`, asserts success, and that the `wrote <path> (<what>)`
+/// lines at the end of stdout name exactly the files the run added.
+fn names_every_written_file(dir: &Path, args: &[&str]) -> String {
+    let before = tree(dir);
+    let out = ok(&run_subdyn(dir, args));
+    let added: Vec<String> = tree(dir)
+        .into_iter()
+        .filter(|f| !before.contains(f))
+        .collect();
+    assert!(!added.is_empty(), "{args:?} wrote nothing");
+    let named: Vec<String> = out
+        .lines()
+        .filter_map(|l| l.strip_prefix("wrote "))
+        .map(|l| {
+            let (path, what) = l.split_once(" (").expect("wrote <path> (<what>)");
+            assert!(what.ends_with(')') && what.len() > 1, "{args:?}: {l}");
+            path.to_string()
+        })
+        .collect();
+    let mut sorted = named.clone();
+    sorted.sort();
+    assert_eq!(sorted, added, "{args:?} named these files:\n{out}");
+    // The list closes the output: nothing after the first `wrote` line but more of them.
+    let tail: Vec<&str> = out
+        .lines()
+        .skip_while(|l| !l.starts_with("wrote "))
+        .collect();
+    assert_eq!(tail.len(), named.len(), "{args:?}:\n{out}");
+    out
+}
+
+#[test]
+fn every_verb_names_every_file_it_wrote() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    copy(d, "opensubdiv/cube.obj", "cube.obj");
+    names_every_written_file(d, &["subdivide", "-o", "s.obj", "--report", "s.json"]);
+    names_every_written_file(
+        d,
+        &["limit", "cube.obj", "-o", "l.ply", "--report", "l.json"],
+    );
+    let out = names_every_written_file(
+        d,
+        &[
+            "lattice", "cube.obj", "-o", "lat.json", "--report", "lr.json",
+        ],
+    );
+    assert!(out.contains("wrote lat.json (lattice)\n"), "{out}");
+    write(
+        d,
+        "moves.json",
+        br#"{"moves": [{"vertex": 0, "offset": [0, 0, -0.2]}]}"#,
+    );
+    names_every_written_file(
+        d,
+        &[
+            "ffd",
+            "cube.obj",
+            "--lattice",
+            "lat.json",
+            "--moves",
+            "moves.json",
+            "-o",
+            "f.obj",
+            "--report",
+            "fr.json",
+            "--quiet",
+        ],
+    );
+    names_every_written_file(
+        d,
+        &[
+            "compare",
+            "f.obj",
+            "cube.obj",
+            "--report",
+            "cr.json",
+            "--distances-out",
+            "cd.txt",
+        ],
+    );
+    names_every_written_file(d, &["render", "f.obj", "-o", "f.png", "--size", "64,48"]);
+    write(
+        d,
+        "ops.json",
+        br#"{"dt": 0.005, "steps": 20, "ops": [{"step": 0, "op": "fix", "points": [0]}]}"#,
+    );
+    let out = names_every_written_file(
+        d,
+        &[
+            "sculpt",
+            "lat.json",
+            "--level",
+            "1",
+            "--script",
+            "ops.json",
+            "--out-dir",
+            "frames",
+            "--every",
+            "10",
+        ],
+    );
+    assert!(
+        out.contains("wrote frames/frame_0000020.obj (frame, step 20)\n"),
+        "{out}"
+    );
+    write(d, "sphere.xyz", sphere_xyz(800).as_bytes());
+    names_every_written_file(
+        d,
+        &[
+            "fit",
+            "sphere.xyz",
+            "-o",
+            "fit.obj",
+            "--max-level",
+            "1",
+            "--report",
+            "fit.json",
+            "--plot",
+            "fit.png",
+            "--limit-out",
+            "fit_limit.ply",
+            "--quiet",
+        ],
+    );
+}
+
+#[test]
+fn a_lattice_can_be_inspected_listed_and_its_moves_format_is_in_the_help() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    copy(d, "opensubdiv/cube.obj", "cube.obj");
+    let out = ok(&run_subdyn(
+        d,
+        &[
+            "lattice",
+            "cube.obj",
+            "--octree-levels",
+            "1",
+            "-o",
+            "lat.json",
+            "--list-vertices",
+        ],
+    ));
+    let rows: Vec<Vec<f64>> = out
+        .lines()
+        .skip_while(|l| !l.trim_start().starts_with("vertex"))
+        .skip(1)
+        .take_while(|l| !l.starts_with("wrote "))
+        .map(|l| l.split_whitespace().map(|t| t.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 27, "{out}");
+    let lattice = subdyn::io::read_lattice(d.join("lat.json")).unwrap();
+    for (i, row) in rows.iter().enumerate() {
+        assert_eq!(row[0], i as f64);
+        let p = lattice.positions[i];
+        assert!((row[1] - p.x).abs() + (row[2] - p.y).abs() + (row[3] - p.z).abs() < 1e-5);
+    }
+
+    let text = ok(&run_subdyn(d, &["info", "lat.json"]));
+    assert!(text.contains("control points:       27"), "{text}");
+    assert!(
+        text.contains("cells:                8 (8 hexahedra)"),
+        "{text}"
+    );
+    let json: Value =
+        serde_json::from_str(&ok(&run_subdyn(d, &["info", "lat.json", "--json"]))).unwrap();
+    assert_eq!(json["kind"], "lattice");
+    assert_eq!(json["control_points"], 27);
+    assert_eq!(json["faces"], 36);
+    assert_eq!(json["boundary_faces"], 24);
+
+    let help = ok(&run_subdyn(d, &["ffd", "--help"]));
+    assert!(!help.contains("see `subdyn ffd --help`"), "{help}");
+    assert!(
+        help.contains(r#"{"vertex": 7, "position": [1, 2, 3]}"#),
+        "{help}"
+    );
+    assert!(help.contains("--list-vertices"), "{help}");
+}
+
+/// The examples of `docs/formats.md` are read by the verbs they document.
+#[test]
+fn the_examples_of_the_formats_page_are_read() {
+    let page =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/formats.md"))
+            .unwrap();
+    let blocks = |lang: &str| -> Vec<String> {
+        page.split(&format!("```{lang}\n"))
+            .skip(1)
+            .map(|b| b.split("```").next().unwrap().to_string())
+            .collect()
+    };
+    let (json, text) = (blocks("json"), blocks("text"));
+    assert!(
+        json.len() >= 3 && !text.is_empty(),
+        "code blocks of formats.md"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    copy(d, "opensubdiv/cube.obj", "cube.obj");
+    write(d, "c.creases", text[0].as_bytes());
+    ok(&run_subdyn(
+        d,
+        &[
+            "subdivide",
+            "cube.obj",
+            "--creases",
+            "c.creases",
+            "-o",
+            "s.obj",
+        ],
+    ));
+    write(d, "lat.json", json[0].as_bytes());
+    write(d, "moves.json", json[1].as_bytes());
+    let info: Value =
+        serde_json::from_str(&ok(&run_subdyn(d, &["info", "lat.json", "--json"]))).unwrap();
+    assert_eq!(info["control_points"], 8);
+    let out = ok(&run_subdyn(
+        d,
+        &[
+            "ffd",
+            "cube.obj",
+            "--lattice",
+            "lat.json",
+            "--moves",
+            "moves.json",
+            "-o",
+            "f.obj",
+        ],
+    ));
+    assert!(out.contains("wrote f.obj (deformed mesh)"), "{out}");
+    let sidecar: Value = serde_json::from_str(&json[2]).expect("the sidecar example is JSON");
+    assert_eq!(sidecar["dims"], serde_json::json!([128, 128, 96]));
+}
+
+#[test]
+fn a_json_file_that_is_no_lattice_is_refused_with_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "ops.json", br#"{"dt": 0.01, "steps": 10}"#);
+    let out = run_subdyn(d, &["info", "ops.json"]);
+    assert_clean_failure(
+        d,
+        &out,
+        &["ops.json", "neither lattice JSON"],
+        &["ops.json"],
+    );
+    let out = run_subdyn(d, &["render", "ops.json", "-o", "o.png"]);
+    assert_clean_failure(d, &out, &["ops.json", "not lattice JSON"], &["ops.json"]);
+    // A broken lattice names the file and the element.
+    write(
+        d,
+        "bad.json",
+        br#"{"vertices": [[0, 0, 0]], "hexahedra": [[0, 0, 0, 0, 0, 0, 0, 0]]}"#,
+    );
+    let out = run_subdyn(d, &["render", "bad.json", "-o", "o.png"]);
+    assert_clean_failure(d, &out, &["bad.json", "face 0"], &["bad.json", "ops.json"]);
+}

@@ -614,3 +614,100 @@ fn pictures_side_by_side_keep_their_pixels_and_places() {
     assert_eq!(s.get(1, 3), Some([255, 255, 255]));
     assert!(Picture::side_by_side(&[]).is_err());
 }
+
+/// Pixels of exactly `color`.
+fn count_color(png: &image::RgbImage, color: Rgb) -> usize {
+    png.pixels().filter(|p| p.0 == color).count()
+}
+
+#[test]
+fn labels_are_drawn_at_their_points() {
+    let cube = unit_cube();
+    let mut scene = Scene {
+        meshes: vec![MeshLayer::wireframe(&cube, subdyn::render::EDGES)],
+        ..Scene::default()
+    };
+    let options = RenderOptions {
+        width: 200,
+        height: 150,
+        ..RenderOptions::default()
+    };
+    let plain = render(&scene, &options).unwrap();
+    assert_eq!(plain.count(|c| c == subdyn::render::LABELS), 0);
+    scene.labels = vec![subdyn::render::Label::new(cube.positions[0], "17")];
+    let labelled = render(&scene, &options).unwrap();
+    let ink = labelled.count(|c| c == subdyn::render::LABELS);
+    assert!(ink > 10, "{ink} label pixels");
+    // Near the projected point, not elsewhere: right of it and above.
+    let (lo, hi) = subdyn::math::bounding_box(&cube.positions).unwrap();
+    let mut camera = Camera::orbit(
+        lo,
+        hi,
+        options.azimuth,
+        options.elevation,
+        options.projection,
+    )
+    .unwrap();
+    camera.fit(&cube.positions, [0.0, 0.0, 200.0, 150.0], options.margin);
+    let p = camera.project(&cube.positions[0]);
+    for y in 0..150 {
+        for x in 0..200 {
+            if labelled.get(x, y) == Some(subdyn::render::LABELS) {
+                let (dx, dy) = (f64::from(x) - p.x, f64::from(y) - p.y);
+                assert!(
+                    (0.0..=20.0).contains(&dx) && (-12.0..=2.0).contains(&dy),
+                    "({x}, {y}) vs {p:?}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn cli_draws_a_lattice_as_a_cage_with_numbered_control_points() {
+    let dir = cube_dir();
+    let d = dir.path();
+    let lattice = subdyn(
+        d,
+        &[
+            "lattice",
+            "cube.obj",
+            "--octree-levels",
+            "1",
+            "-o",
+            "lat.json",
+        ],
+    );
+    assert!(lattice.status.success());
+    let mut inks = Vec::new();
+    for (png, extra) in [
+        ("plain.png", None),
+        ("numbered.png", Some("--label-vertices")),
+    ] {
+        let mut args = vec!["render", "lat.json", "-o", png, "--size", "320,240"];
+        args.extend(extra);
+        let out = subdyn(d, &args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("27 control points"), "{text}");
+        assert!(
+            text.contains(&format!("wrote {png} (picture, 320×240)")),
+            "{text}"
+        );
+        let png = image::open(d.join(png)).unwrap().to_rgb8();
+        assert!(count_color(&png, subdyn::render::EDGES) > 500, "cell edges");
+        inks.push(count_color(&png, subdyn::render::LABELS));
+    }
+    assert_eq!(inks[0], 0);
+    assert!(inks[1] > 27 * 10, "27 numbers: {} pixels", inks[1]);
+    // Mesh-only options are refused with one line, and nothing is written.
+    let out = subdyn(d, &["render", "lat.json", "-o", "x.png", "--limit", "2"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--limit is for meshes"), "{err}");
+    assert!(!d.join("x.png").exists());
+}

@@ -454,6 +454,32 @@ fn sculpt_cli_rejects_bad_scripts_with_one_line() {
             "smaller dt",
         ),
         (r#"{"dt": 0.01, "steps": 10"#, "not a valid sculpt script"),
+        ("{\"dt\": 0.01, // the step\n \"steps\": 10}", "no comments"),
+        // Checked before the first step, however late the op: nothing is written.
+        (
+            r#"{"dt": 0.01, "steps": 900, "ops": [{"step": 0, "op": "release"}, {"step": 800, "op": "free", "points": [3, 27]}]}"#,
+            "op 1 (step 800, free): control point 27 does not exist",
+        ),
+        (
+            r#"{"dt": 0.01, "steps": 900, "ops": [{"step": 700, "op": "trim", "cell": 8}]}"#,
+            "op 0 (step 700, trim)",
+        ),
+        (
+            r#"{"dt": 0.01, "steps": 900, "ops": [{"step": 700, "op": "damping", "value": -1}]}"#,
+            "op 0 (step 700, damping)",
+        ),
+        (
+            r#"{"dt": 0.01, "steps": 900, "ops": [{"step": 9, "op": "rope", "at": [1, 1, 1], "to": [2, 2, 2], "until": 5}]}"#,
+            "op 0 (step 9, rope): until = 5",
+        ),
+        (
+            r#"{"dt": 0.01, "steps": 900, "ops": [{"step": 9, "op": "stiffness"}]}"#,
+            "op 0 (step 9, stiffness)",
+        ),
+        (
+            r#"{"dt": 0.01, "steps": 900, "material": {"density": -1}}"#,
+            "material",
+        ),
     ];
     for (i, (script, expect)) in bad.iter().enumerate() {
         std::fs::write(dir.path().join("bad.json"), script).unwrap();
@@ -476,6 +502,10 @@ fn sculpt_cli_rejects_bad_scripts_with_one_line() {
         assert!(
             err.contains(expect),
             "script {i}: expected {expect:?} in {err}"
+        );
+        assert!(
+            !dir.path().join("bad").exists(),
+            "script {i}: frames written"
         );
     }
     let out = common::run_subdyn(
@@ -512,6 +542,68 @@ fn sculpt_cli_rejects_bad_scripts_with_one_line() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("broken.json"), "{err}");
+}
+
+/// The script of `docs/sculpt.md` is plain JSON and runs on the lattice the
+/// page says to make (extrude, then trim: every op applies).
+#[test]
+fn the_documented_sculpt_script_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let page = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/sculpt.md"),
+    )
+    .unwrap();
+    let script = page
+        .split("```json\n")
+        .nth(1)
+        .and_then(|rest| rest.split("```").next())
+        .expect("a ```json block in docs/sculpt.md");
+    serde_json::from_str::<serde_json::Value>(script).expect("plain JSON");
+    std::fs::write(dir.path().join("ops.json"), script).unwrap();
+    std::fs::copy(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/opensubdiv/cube.obj"),
+        dir.path().join("cube.obj"),
+    )
+    .unwrap();
+    let lattice = common::run_subdyn(
+        dir.path(),
+        &[
+            "lattice",
+            "cube.obj",
+            "--octree-levels",
+            "1",
+            "-o",
+            "lat.json",
+        ],
+    );
+    assert!(lattice.status.success());
+    let out = common::run_subdyn(
+        dir.path(),
+        &[
+            "sculpt",
+            "lat.json",
+            "--level",
+            "1",
+            "--script",
+            "ops.json",
+            "--out-dir",
+            "out",
+            "--every",
+            "300",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let log: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("out/log.json")).unwrap())
+            .unwrap();
+    let ops = log["ops"].as_array().unwrap();
+    assert_eq!(ops.len(), 10);
+    assert!(ops.iter().any(|o| o["op"] == "extrude"));
+    assert!(ops.iter().any(|o| o["op"] == "trim"));
 }
 
 #[test]

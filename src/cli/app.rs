@@ -123,7 +123,10 @@ pub fn run() -> ExitCode {
         Command::Sculpt(args) => sculpt::run(&args),
         Command::Bench(cmd) => bench::run(&cmd),
     };
-    let result = result.and_then(|()| Ok(batch.commit()?));
+    // The summaries and `wrote` lines are printed once the files are in place.
+    let result = result
+        .and_then(|()| Ok(batch.commit()?))
+        .and_then(|()| common::print_pending());
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {

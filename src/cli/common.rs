@@ -1,7 +1,9 @@
-//! Helpers every verb shares: one-line errors, reports, stdout, timing.
+//! Helpers every verb shares: one-line errors, reports, stdout, the list of
+//! written files, timing.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, PoisonError};
 use std::time::Instant;
 
 use anyhow::Context;
@@ -108,6 +110,53 @@ pub fn print_stdout(text: &str) -> anyhow::Result<()> {
     }
 }
 
+/// The files a verb wrote, in the order it wrote them. Every verb ends its
+/// output with [`Written::lines`]: one `wrote <path> (<what>)` line per file,
+/// so a user (or a script) finds every output the same way whatever the verb.
+#[derive(Debug, Default)]
+pub struct Written(Vec<(PathBuf, String)>);
+
+impl Written {
+    /// No file yet.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Records that `path` was written; `what` says what it holds, e.g.
+    /// `"control mesh"` or `"report"`.
+    pub fn add(&mut self, path: &Path, what: impl Into<String>) {
+        self.0.push((path.to_path_buf(), what.into()));
+    }
+
+    /// One line per file: `wrote <path> (<what>)`.
+    pub fn lines(&self) -> String {
+        self.0
+            .iter()
+            .map(|(path, what)| format!("wrote {} ({what})\n", path.display()))
+            .collect()
+    }
+
+    /// Prints `text` then [`Written::lines`] on stdout once the run's files
+    /// are in place: the text waits for [`print_pending`], which the command
+    /// line calls after renaming the staged outputs, so no `wrote` line names
+    /// a file that a failed commit left out.
+    pub fn print_after(&self, text: &str) -> anyhow::Result<()> {
+        let mut pending = PENDING.lock().unwrap_or_else(PoisonError::into_inner);
+        pending.push_str(text);
+        pending.push_str(&self.lines());
+        Ok(())
+    }
+}
+
+/// What [`Written::print_after`] holds back until the outputs are committed.
+static PENDING: Mutex<String> = Mutex::new(String::new());
+
+/// Prints (and forgets) what [`Written::print_after`] held back.
+pub fn print_pending() -> anyhow::Result<()> {
+    let text = std::mem::take(&mut *PENDING.lock().unwrap_or_else(PoisonError::into_inner));
+    print_stdout(&text)
+}
+
 /// Prints a warning line on stderr unless `quiet`.
 pub fn warn(quiet: bool, message: &str) {
     if !quiet {
@@ -171,6 +220,18 @@ mod tests {
         assert_eq!(error_line(&err), "a.obj: no such file");
         let err = anyhow::anyhow!("inner\nline").context("outer");
         assert_eq!(error_line(&err), "outer: inner line");
+    }
+
+    #[test]
+    fn written_names_every_file_one_per_line() {
+        let mut w = Written::new();
+        w.add(Path::new("out/fit.obj"), "control mesh");
+        w.add(&PathBuf::from("r.json"), "report");
+        assert_eq!(
+            w.lines(),
+            "wrote out/fit.obj (control mesh)\nwrote r.json (report)\n"
+        );
+        assert_eq!(Written::new().lines(), "");
     }
 
     #[test]

@@ -17,7 +17,7 @@ use subdyn::metrics::{CompareParams, Comparison, OneSided, Surface, compare, com
 use subdyn::subdivision::RefineOptions;
 
 use super::common::{
-    about_file, bbox_json, check_output_dir, print_stdout, seconds, thousands, timed, write_report,
+    Written, about_file, bbox_json, check_output_dir, seconds, thousands, timed, write_report,
 };
 use super::options::{Boundary, read_polygon_mesh, warn_isolated};
 use super::progress::Progress;
@@ -159,8 +159,10 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let c = result?;
     drop(progress);
 
+    let mut written = Written::new();
     if let Some(path) = &args.distances_out {
         write_distances(path, &c.a_to_b)?;
+        written.add(path, "distances A to B");
     }
     let total_s = seconds(start);
     let text = table(args, &a, &b, &c);
@@ -181,8 +183,9 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
             "read": read_s, "build": build_s, "compare": compare_s, "total": total_s,
         });
         write_report(path, &report)?;
+        written.add(path, "report");
     }
-    print_stdout(&text)
+    written.print_after(&text)
 }
 
 /// Reads `A`: a polygon mesh, or (no faces) a point cloud with its normals.
@@ -361,12 +364,6 @@ fn table(args: &CompareArgs, a: &Side, b: &PolyMesh, c: &Comparison) -> String {
         && let Some(v) = c.normal_consistency
     {
         let _ = writeln!(s, "{:<34}{v:>14.5}", "normal consistency (both ways)");
-    }
-    if let Some(path) = &args.report {
-        let _ = writeln!(s, "report: {}", path.display());
-    }
-    if let Some(path) = &args.distances_out {
-        let _ = writeln!(s, "distances: {}", path.display());
     }
     s
 }

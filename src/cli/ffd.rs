@@ -18,13 +18,14 @@ use subdyn::lattice::MAX_LATTICE_LEVELS;
 use subdyn::math::{Point3, Vector3};
 
 use super::common::{
-    about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, write_report,
+    Written, about_file, check_mesh_output, check_output_dir, seconds, thousands, write_report,
 };
 use super::options::read_polygon_mesh;
 use super::progress::Progress;
 
 /// Arguments of `subdyn ffd`.
 #[derive(Debug, Args)]
+#[command(after_help = MOVES_HELP)]
 pub struct FfdArgs {
     /// The model to deform (.obj, .ply, .off).
     #[arg(value_name = "MODEL")]
@@ -40,7 +41,7 @@ pub struct FfdArgs {
         required_unless_present = "moves"
     )]
     pub deformed: Option<PathBuf>,
-    /// Control-point moves (JSON, see `subdyn ffd --help`).
+    /// Control-point moves (JSON: {"moves": [{"vertex": 3, "offset": [0, 0, 0.5]}, …]}; format below).
     #[arg(long, value_name = "MOVES.json")]
     pub moves: Option<PathBuf>,
     /// Refinement levels of the lattice (1 to 6).
@@ -56,6 +57,14 @@ pub struct FfdArgs {
     #[arg(short, long)]
     pub quiet: bool,
 }
+
+/// The `--moves` format, shown by `subdyn ffd --help`.
+const MOVES_HELP: &str = "MOVES.json lists control points of the lattice to move:
+  {\"moves\": [{\"vertex\": 3, \"offset\": [0, 0, 0.5]}, {\"vertex\": 7, \"position\": [1, 2, 3]}]}
+Each move names a control point by its number (its place in the lattice file's \"vertices\", from 0)
+and gives exactly one of \"offset\" (added to its rest position) or \"position\" (where it goes).
+`subdyn lattice MODEL -o LAT.json --list-vertices` prints the numbers and positions;
+`subdyn render LAT.json -o LAT.png --label-vertices` draws them.";
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -162,6 +171,8 @@ pub fn run(args: &FfdArgs) -> anyhow::Result<()> {
     progress.stage(format!("writing {}", args.output.display()));
     write_mesh(&args.output, &out, None).map_err(|e| about_file(e, &args.output))?;
     drop(progress);
+    let mut written = Written::new();
+    written.add(&args.output, "deformed mesh");
     let r = &ffd.report;
     if r.outside > 0 && !args.quiet {
         super::common::warn(
@@ -185,9 +196,10 @@ pub fn run(args: &FfdArgs) -> anyhow::Result<()> {
             "timings_s": {"refine": r.refine_s, "embed": r.embed_s, "deform": deform_s, "total": seconds(start)},
         });
         write_report(report, &value)?;
+        written.add(report, "report");
     }
-    print_stdout(&format!(
-        "deformed {} of {} vertices of {} with {} ({} cells, {} levels → {} cells); {} outside; written to {}\n",
+    written.print_after(&format!(
+        "deformed {} of {} vertices of {} with {} ({} cells, {} levels → {} cells); {} outside\n",
         thousands(r.embedded),
         thousands(r.points),
         args.model.display(),
@@ -196,6 +208,5 @@ pub fn run(args: &FfdArgs) -> anyhow::Result<()> {
         args.levels,
         thousands(r.level_cells),
         thousands(r.outside),
-        args.output.display()
     ))
 }

@@ -15,7 +15,7 @@ use subdyn::finetune::{
 use subdyn::math::Real;
 use subdyn::render::{check_png_path, write_png};
 
-use super::common::{about_file, check_output_dir, print_stdout, warn, write_report};
+use super::common::{Written, about_file, check_output_dir, warn, write_report};
 
 /// Arguments of `subdyn finetune curve`.
 #[derive(Debug, Args)]
@@ -50,7 +50,8 @@ pub struct CurveArgs {
     /// Draw the original and the fine-tuned curve (top view) to a PNG.
     #[arg(long, value_name = "P.png")]
     pub png: Option<PathBuf>,
-    /// No summary on stdout and no warnings.
+    /// No warnings (the summary and the written files are still printed, as
+    /// every verb does).
     #[arg(short, long)]
     pub quiet: bool,
 }
@@ -103,6 +104,8 @@ pub fn run(args: &CurveArgs) -> anyhow::Result<()> {
         );
     }
     write_json(&args.output, &curve_json(&curve, topo.closed))?;
+    let mut written = Written::new();
+    written.add(&args.output, "fine-tuned curve");
     if let Some(path) = &args.report {
         write_report(
             path,
@@ -128,24 +131,23 @@ pub fn run(args: &CurveArgs) -> anyhow::Result<()> {
                 "energies": report.energies,
             }),
         )?;
+        written.add(path, "report");
     }
     if let Some(path) = &args.png {
         let layers = comparison_layers(&topo, &points, &curve)?;
         let picture = curve_picture(&layers, "blue: original  red: fine-tuned", 800, 600)?;
         write_png(path, &picture)?;
+        written.add(path, "picture");
     }
-    if !args.quiet {
-        print_stdout(&format!(
-            "fine-tuned curve: degree {}, {} control points, {} iterations, energy {:.3e} -> {:.3e}, gap {:.1e} -> {:.1e}, {:.1} ms\n",
-            report.degree,
-            report.num_control_points,
-            report.iterations,
-            report.initial_energy,
-            report.final_energy,
-            report.gap_before,
-            report.gap_after,
-            report.seconds * 1e3
-        ))?;
-    }
-    Ok(())
+    written.print_after(&format!(
+        "fine-tuned curve: degree {}, {} control points, {} iterations, energy {:.3e} -> {:.3e}, gap {:.1e} -> {:.1e}, {:.1} ms\n",
+        report.degree,
+        report.num_control_points,
+        report.iterations,
+        report.initial_energy,
+        report.final_energy,
+        report.gap_before,
+        report.gap_after,
+        report.seconds * 1e3
+    ))
 }

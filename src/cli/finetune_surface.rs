@@ -15,7 +15,7 @@ use subdyn::math::Real;
 use subdyn::subdivision::NonUniformHierarchy;
 use subdyn::topology::Level;
 
-use super::common::{about_file, check_mesh_output, check_output_dir, print_stdout, write_report};
+use super::common::{Written, about_file, check_mesh_output, check_output_dir, write_report};
 use super::options::read_polygon_mesh;
 
 /// The scheme of the input mesh.
@@ -173,6 +173,8 @@ pub fn run(args: &SurfaceArgs) -> anyhow::Result<()> {
         })?;
     let (out, report) = problem.solve()?;
     write_mesh(&args.output, &out, None).map_err(|e| about_file(e, &args.output))?;
+    let mut written = Written::new();
+    written.add(&args.output, "control mesh");
     if let Some(path) = &args.knots_out {
         atomic_write(path, |w| {
             writeln!(w, "# i j knot-interval (subdyn finetune surface)")?;
@@ -182,6 +184,7 @@ pub fn run(args: &SurfaceArgs) -> anyhow::Result<()> {
             Ok(())
         })
         .map_err(|e| about_file(e, path))?;
+        written.add(path, "knot intervals");
     }
     if let Some(path) = &args.refined {
         let h = NonUniformHierarchy::new(
@@ -196,6 +199,7 @@ pub fn run(args: &SurfaceArgs) -> anyhow::Result<()> {
         };
         fine.validate()?;
         write_mesh(path, &fine, None).map_err(|e| about_file(e, path))?;
+        written.add(path, format!("refined mesh, level {}", args.levels));
     }
     let (e0, e1) = (
         report.energies.first().copied().unwrap_or(0.0),
@@ -214,12 +218,12 @@ pub fn run(args: &SurfaceArgs) -> anyhow::Result<()> {
                 "report": report,
             }),
         )?;
+        written.add(path, "report");
     }
-    print_stdout(&format!(
-        "fine-tuned {name}: energy {e0:.3e} -> {e1:.3e} in {} iterations ({}), largest move {:.4}, written to {}\n",
+    written.print_after(&format!(
+        "fine-tuned {name}: energy {e0:.3e} -> {e1:.3e} in {} iterations ({}), largest move {:.4}\n",
         report.iterations,
         report.termination,
         report.max_displacement,
-        args.output.display()
     ))
 }

@@ -14,7 +14,7 @@ use subdyn::limit::limit_surface_mesh;
 use subdyn::subdivision::{RefineOptions, Refiner};
 
 use super::common::{
-    about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, warn,
+    Written, about_file, check_mesh_output, check_output_dir, seconds, thousands, warn,
     write_report,
 };
 use super::options::{LimitFacesArgs, read_polygon_mesh};
@@ -201,6 +201,8 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     let result = &run.result;
     progress.stage(format!("writing {}", args.output.display()));
     write_mesh(&args.output, &result.control, None).map_err(|e| about_file(e, &args.output))?;
+    let mut written = Written::new();
+    written.add(&args.output, "control mesh");
     if let Some(path) = &args.limit_out {
         let (surf, normals) = limit_surface_mesh(
             &result.control,
@@ -209,9 +211,11 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             args.faces.quads,
         )?;
         write_mesh(path, &surf, Some(&normals)).map_err(|e| about_file(e, path))?;
+        written.add(path, "limit surface");
     }
     if let Some(path) = &args.plot {
         write_plot(path, &result.report)?;
+        written.add(path, "convergence plot");
     }
     drop(progress);
     if let Some(path) = &args.report {
@@ -226,16 +230,12 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             map.insert("total_s".into(), json!(seconds(start)));
         }
         write_report(path, &value)?;
+        written.add(path, "report");
     }
     for w in &result.report.quality.warnings {
         warn(args.quiet, w);
     }
-    print_stdout(&summary(
-        &name,
-        &args.output,
-        args.limit_out.as_deref(),
-        &result.report,
-    ))
+    written.print_after(&summary(&name, &result.report))
 }
 
 /// Error against time, one colour per level (p95 solid markers, RMS as a
@@ -292,7 +292,7 @@ fn fit_start(init: &str, resolution: usize, quiet: bool) -> anyhow::Result<FitSt
     Ok(FitStart::Mesh(mesh))
 }
 
-fn summary(name: &str, output: &Path, limit: Option<&Path>, r: &FitReport) -> String {
+fn summary(name: &str, r: &FitReport) -> String {
     let left_out = if r.outliers > 0 {
         format!(
             ", {} outliers left out of the springs",
@@ -323,9 +323,6 @@ fn summary(name: &str, output: &Path, limit: Option<&Path>, r: &FitReport) -> St
             l.refinement
         ));
     }
-    s.push_str(&format!("errors are data-to-surface distances from all points (outliers included) in % of the scan's bounding-box diagonal\ncontrol mesh written to {}\n", output.display()));
-    if let Some(p) = limit {
-        s.push_str(&format!("limit surface written to {}\n", p.display()));
-    }
+    s.push_str("errors are data-to-surface distances from all points (outliers included) in % of the scan's bounding-box diagonal\n");
     s
 }

@@ -1,4 +1,5 @@
-//! `subdyn info IN [--json]`: describe a mesh or a point file.
+//! `subdyn info IN [--json]`: describe a mesh, a point file, a volume or a
+//! lattice.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -17,8 +18,9 @@ use super::mesh_stats::{MeshStats, mesh_stats};
 /// Arguments of `subdyn info`.
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Mesh or point file (.obj, .ply, .off, .xyz, optionally .gz), or a volume
-    /// (.nii, .nii.gz, .tif, .exr, .raw/.json, or a directory of slices).
+    /// Mesh or point file (.obj, .ply, .off, .xyz, optionally .gz), a volume
+    /// (.nii, .nii.gz, .tif, .exr, .raw/.json, or a directory of slices), or a
+    /// lattice (.json, as `subdyn lattice` writes it).
     #[arg(value_name = "IN")]
     pub input: PathBuf,
     /// Print one JSON object instead of text.
@@ -29,6 +31,15 @@ pub struct InfoArgs {
 /// Runs `subdyn info`.
 pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     let path = &args.input;
+    if subdyn::io::is_lattice_file(path) {
+        return super::info_lattice::run(path, args.json);
+    }
+    if super::render::is_json(path) && !has_dims(path) {
+        anyhow::bail!(
+            "{}: neither lattice JSON (an object with a \"vertices\" list) nor a volume header (with \"dims\")",
+            path.display()
+        );
+    }
     if super::info_volume::is_volume(path) {
         return super::info_volume::run(path, args.json);
     }
@@ -79,6 +90,16 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
     print_stdout(&text)
 }
 
+/// Whether the JSON file at `path` is an object with a `"dims"` field (a
+/// volume header); unreadable or invalid JSON counts as yes, so that the
+/// volume reader names the problem.
+fn has_dims(path: &Path) -> bool {
+    subdyn::io::read_input(path)
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        .is_none_or(|v| v.get("dims").is_some())
+}
+
 fn json_line(value: &serde_json::Value) -> String {
     format!("{value}\n")
 }
@@ -91,7 +112,8 @@ fn header(path: &Path, format: MeshFormat) -> String {
     )
 }
 
-fn bbox_text(points: &[Point3]) -> String {
+/// The `bounding box:` and `bbox diagonal:` lines.
+pub fn bbox_text(points: &[Point3]) -> String {
     match bounding_box(points) {
         Some((lo, hi)) => format!(
             "bounding box:         [{:.6}, {:.6}, {:.6}] to [{:.6}, {:.6}, {:.6}]\nbbox diagonal:        {:.6}\n",

@@ -13,7 +13,7 @@ use subdyn::lattice::{
     BoxKind, BoxLatticeParams, box_lattice, locally_refined, shrunk_box_lattice,
 };
 
-use super::common::{about_file, check_output_dir, print_stdout, thousands, write_report};
+use super::common::{Written, about_file, check_output_dir, thousands, write_report};
 
 /// Box orientation on the command line.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -58,6 +58,20 @@ pub struct LatticeArgs {
     /// Write a JSON report.
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
+    /// Also print every control point: its number (the `"vertex"` of
+    /// `subdyn ffd --moves`) and its position. `subdyn render LAT.json
+    /// --label-vertices` shows the numbers in a picture.
+    #[arg(long)]
+    pub list_vertices: bool,
+}
+
+/// `vertex x y z` lines, one per control point, numbered from 0.
+fn vertex_table(positions: &[subdyn::math::Point3]) -> String {
+    let mut s = format!("{:>6}  {:>12}  {:>12}  {:>12}\n", "vertex", "x", "y", "z");
+    for (i, p) in positions.iter().enumerate() {
+        s += &format!("{i:>6}  {:>12.6}  {:>12.6}  {:>12.6}\n", p.x, p.y, p.z);
+    }
+    s
 }
 
 /// Runs `subdyn lattice`.
@@ -102,6 +116,8 @@ pub fn run(args: &LatticeArgs) -> anyhow::Result<()> {
         (lat, Some(r))
     };
     write_lattice(&args.output, &lat).map_err(|e| about_file(e, &args.output))?;
+    let mut written = Written::new();
+    written.add(&args.output, "lattice");
     if let Some(report) = &args.report {
         write_report(
             report,
@@ -117,6 +133,7 @@ pub fn run(args: &LatticeArgs) -> anyhow::Result<()> {
                 "local_refinement": local,
             }),
         )?;
+        written.add(report, "report");
     }
     let mut extra = String::new();
     if let Some(r) = &shrink {
@@ -131,13 +148,15 @@ pub fn run(args: &LatticeArgs) -> anyhow::Result<()> {
             r.refined, r.non_hexahedral
         );
     }
-    print_stdout(&format!(
-        "lattice around {} ({} vertices): {} control points, {} cells (of {} before culling){extra}, written to {}\n",
+    if args.list_vertices {
+        extra += &format!("\n{}", vertex_table(&lat.positions).trim_end());
+    }
+    written.print_after(&format!(
+        "lattice around {} ({} vertices): {} control points, {} cells (of {} before culling){extra}\n",
         args.model.display(),
         thousands(mesh.num_vertices()),
         thousands(lat.num_vertices()),
         thousands(lat.topology.num_cells()),
         thousands(1usize << (3 * args.octree_levels)),
-        args.output.display()
     ))
 }

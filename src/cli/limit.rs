@@ -10,8 +10,8 @@ use subdyn::io::write_mesh;
 use subdyn::limit::tessellate;
 
 use super::common::{
-    about_file, bbox_json, check_mesh_output, check_output_dir, print_stdout, seconds, thousands,
-    timed, write_report,
+    Written, about_file, bbox_json, check_mesh_output, check_output_dir, seconds, thousands, timed,
+    write_report,
 };
 use super::options::{LimitFacesArgs, RefineArgs, read_polygon_mesh};
 use super::progress::Progress;
@@ -98,6 +98,8 @@ pub fn run(args: &LimitArgs) -> anyhow::Result<()> {
     let (written, write_s) = timed(|| write_mesh(&args.output, &out, normals));
     written.map_err(|e| about_file(e, &args.output))?;
     drop(progress);
+    let mut written = Written::new();
+    written.add(&args.output, "limit surface");
 
     if let Some(report) = &args.report {
         let value = json!({
@@ -123,13 +125,13 @@ pub fn run(args: &LimitArgs) -> anyhow::Result<()> {
             "bbox": bbox_json(&out.positions),
         });
         write_report(report, &value)?;
+        written.add(report, "report");
     }
-    print_stdout(&format!(
-        "tessellated the limit surface of {name} ({0}×{0} per quad): {1} vertices, {2} faces{3}, written to {4}\n",
+    written.print_after(&format!(
+        "tessellated the limit surface of {name} ({0}×{0} per quad): {1} vertices, {2} faces{3}\n",
         args.tess,
         thousands(out.num_vertices()),
         thousands(out.num_faces()),
         if args.normals { " with normals" } else { "" },
-        args.output.display()
     ))
 }

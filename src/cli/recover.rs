@@ -23,7 +23,8 @@ use subdyn::mesh::PolyMesh;
 use subdyn::subdivision::{RefineOptions, Refiner};
 
 use super::common::{
-    about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands, write_report,
+    Written, about_file, check_mesh_output, check_output_dir, print_stdout, seconds, thousands,
+    write_report,
 };
 use super::memory::{StagePeaks, peak_rss, stage_peak};
 use super::options::{LimitFacesArgs, read_polygon_mesh};
@@ -284,14 +285,7 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     let problems = poor_result(&result.report, &params);
     if !problems.is_empty() && !args.accept_poor {
         drop(progress);
-        print_stdout(&summary(
-            args,
-            &notes,
-            read_s,
-            init_s,
-            &result.report,
-            false,
-        ))?;
+        print_stdout(&summary(args, &notes, read_s, init_s, &result.report))?;
         anyhow::bail!(
             "poor result from {}, nothing written: {}; --accept-poor writes it anyway",
             args.input.display(),
@@ -316,6 +310,8 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     };
     progress.stage(format!("writing {}", args.output.display()));
     write_mesh(&args.output, control, None).map_err(|e| about_file(e, &args.output))?;
+    let mut written = Written::new();
+    written.add(&args.output, "control mesh");
     let surface = |mesh: &PolyMesh| -> anyhow::Result<(PolyMesh, Vec<subdyn::math::Vector3>)> {
         let refiner = Refiner::new(mesh, &RefineOptions::default())?;
         Ok(tessellate(&refiner, &mesh.positions, args.tess)?)
@@ -324,6 +320,7 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     if let Some(path) = &args.limit_out {
         write_mesh(path, &args.faces.mesh(&surf), Some(&normals))
             .map_err(|e| about_file(e, path))?;
+        written.add(path, "limit surface");
     }
     let mut slice_files = Vec::new();
     if let Some(dir) = &args.slices_png {
@@ -333,6 +330,9 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
             .map_err(|e| about_file(e, &args.input))?
             .volume;
         slice_files = write_slices(dir, &args.input, &image, &surf, &init_surf)?;
+        for file in &slice_files {
+            written.add(Path::new(file), "slice picture");
+        }
     }
     drop(progress);
     if let Some(path) = &args.report {
@@ -363,22 +363,14 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
             "total_s": seconds(start),
         });
         write_report(path, &value)?;
+        written.add(path, "report");
     }
-    let mut text = summary(args, &notes, read_s, init_s, &result.report, true);
+    let mut text = summary(args, &notes, read_s, init_s, &result.report);
     for p in &problems {
         text.push_str(&format!("poor result accepted (--accept-poor): {p}\n"));
     }
     text.push_str(&memory.line());
-    if !slice_files.is_empty() {
-        text.push_str(&format!(
-            "slices: {} PNGs in {}\n",
-            slice_files.len(),
-            args.slices_png
-                .as_ref()
-                .map_or(String::new(), |d| d.display().to_string())
-        ));
-    }
-    print_stdout(&text)
+    written.print_after(&text)
 }
 
 /// The initial control mesh from --seed, --init or --auto.
@@ -489,7 +481,6 @@ fn summary(
     read_s: f64,
     init_s: f64,
     r: &RecoverReport,
-    written: bool,
 ) -> String {
     let mut s = format!(
         "recovered {} in {:.2} s: {}\n",
@@ -524,12 +515,5 @@ fn summary(
     s.push_str(
         "(offsets: surface to the boundary found along its normal; unresolved: share of the surface that found no boundary within the search range along its normal (± a third of the median control edge, 2 to 12 voxels), so the thin plate, not the image, placed it)\n",
     );
-    if written {
-        s.push_str(&format!("wrote {}", args.output.display()));
-        if let Some(p) = &args.limit_out {
-            s.push_str(&format!(" and {}", p.display()));
-        }
-        s.push('\n');
-    }
     s
 }

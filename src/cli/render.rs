@@ -1,5 +1,6 @@
 //! `subdyn render IN -o OUT.png`: draw a mesh (or its limit surface) and
-//! point clouds with the software rasteriser of `subdyn::render`.
+//! point clouds with the software rasteriser of `subdyn::render`; a lattice
+//! JSON file is drawn as a cage by [`super::render_lattice`].
 
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -12,16 +13,18 @@ use subdyn::math::{Real, bbox_diagonal};
 use subdyn::mesh::{PointCloud, PolyMesh};
 use subdyn::metrics::{TriangleBvh, distances};
 use subdyn::render::{
-    CloudLayer, EDGES, MAX_SIDE, MeshLayer, Projection, RenderOptions, Scene, check_png_path,
-    render, write_png,
+    CloudLayer, EDGES, Label, MAX_SIDE, MeshLayer, Projection, RenderOptions, Scene,
+    check_png_path, render, write_png,
 };
 
-use super::common::{about_file, print_stdout, thousands};
+use super::common::{Written, about_file, thousands};
 use super::options::RefineArgs;
 use super::progress::Progress;
 
 /// Largest `--limit` accepted.
 pub const MAX_LIMIT: usize = 64;
+/// Most vertices `--label-vertices` numbers (more would cover the picture).
+pub const MAX_LABELS: usize = 2_000;
 /// Largest number of limit faces `--limit` may produce.
 const MAX_LIMIT_FACES: f64 = 20_000_000.0;
 
@@ -33,7 +36,9 @@ const MAX_LIMIT_FACES: f64 = 20_000_000.0;
     orange. With --color-by-distance-to, the legend is in % of REF's bounding-box diagonal."
 )]
 pub struct RenderArgs {
-    /// Mesh or point file (.obj, .ply, .off, .xyz); a file without faces is drawn as points.
+    /// Mesh or point file (.obj, .ply, .off, .xyz); a file without faces is
+    /// drawn as points; a lattice (.json, as `subdyn lattice` writes it) as
+    /// the edges of its cells with its control points as dots.
     #[arg(value_name = "IN")]
     pub input: PathBuf,
     /// Output picture (.png).
@@ -68,6 +73,10 @@ pub struct RenderArgs {
     /// Overlay IN's edges (the control cage when --limit is given).
     #[arg(long)]
     pub cage: bool,
+    /// Number IN's vertices in the picture (a lattice's control points: the
+    /// numbers `subdyn ffd --moves` takes); at most 2,000 vertices.
+    #[arg(long)]
+    pub label_vertices: bool,
     /// Radius of point splats in pixels.
     #[arg(long, value_name = "R", default_value_t = 1.5)]
     pub point_size: Real,
@@ -98,6 +107,15 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         && !(1..=MAX_LIMIT).contains(&k)
     {
         anyhow::bail!("--limit {k} is out of range: expected 1 to {MAX_LIMIT}");
+    }
+    if subdyn::io::is_lattice_file(&args.input) {
+        return super::render_lattice::run(args, options);
+    }
+    if is_json(&args.input) {
+        anyhow::bail!(
+            "{}: not lattice JSON (an object with a \"vertices\" list); render draws .obj, .ply, .off and .xyz files and lattices",
+            args.input.display()
+        );
     }
     let progress = Progress::new(args.quiet);
     let name = args.input.display().to_string();
@@ -184,18 +202,46 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         }
     }
 
+    if args.label_vertices {
+        scene.labels = vertex_labels(&mesh.positions, &name)?;
+    }
     progress.stage("drawing");
     let picture = render(&scene, &options)?;
     progress.stage(format!("writing {}", args.output.display()));
     write_png(&args.output, &picture).map_err(|e| about_file(e, &args.output))?;
     drop(progress);
-    print_stdout(&format!(
-        "rendered {name} ({}) to {} ({}×{})\n",
+    let mut written = Written::new();
+    written.add(
+        &args.output,
+        format!("picture, {}×{}", picture.width(), picture.height()),
+    );
+    written.print_after(&format!(
+        "rendered {name} ({})\n",
         describe(surface, cloud.as_ref(), extra.as_ref()),
-        args.output.display(),
-        picture.width(),
-        picture.height()
     ))
+}
+
+/// Whether `path` ends in `.json`.
+pub fn is_json(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+}
+
+/// Labels with the vertex numbers of `positions` (at most [`MAX_LABELS`]);
+/// `name` names the file in the error.
+pub fn vertex_labels(positions: &[subdyn::math::Point3], name: &str) -> anyhow::Result<Vec<Label>> {
+    if positions.len() > MAX_LABELS {
+        anyhow::bail!(
+            "{name}: --label-vertices numbers at most {} vertices, the file has {}",
+            thousands(MAX_LABELS),
+            thousands(positions.len())
+        );
+    }
+    Ok(positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| Label::new(*p, i.to_string()))
+        .collect())
 }
 
 /// Checks and gathers the picture options.

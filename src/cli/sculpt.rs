@@ -9,36 +9,12 @@
 //! `DIR/sculpt_demo.png`, a strip of key frames. Every file is written
 //! atomically.
 //!
-//! # Script format (JSON)
+//! # Script format
 //!
-//! ```json
-//! {
-//!   "dt": 0.002,                // time step in seconds, 0 < dt ≤ 10
-//!   "steps": 900,               // steps to run, 1 to 1,000,000
-//!   "material": {               // optional; defaults of SolidParams
-//!     "density": 1.0, "normal_stiffness": 400, "virtual_stiffness": 400, "damping": 2.0
-//!   },
-//!   "ops": [                    // each at a step in 0..=steps, applied before that step
-//!     {"step": 0,   "op": "rope", "at": [1, 1, 1], "to": [1.5, 1.5, 1.6], "until": 150,
-//!                   "stiffness": 60, "rest_length": 0},
-//!     {"step": 250, "op": "release"},
-//!     {"step": 400, "op": "extrude", "near": [1, 0.75, 0.75]},   // or "face": index
-//!     {"step": 500, "op": "trim", "near": [0.25, 0.25, 0.75]},   // or "cell": index
-//!     {"step": 550, "op": "fix", "box": [[-1, -1, -1], [0.01, 2, 2]]}, // and/or "points": [..]
-//!     {"step": 560, "op": "free", "points": [0, 3]},
-//!     {"step": 600, "op": "stiffness", "normal": 800, "virtual": 200},
-//!     {"step": 600, "op": "damping", "value": 4},
-//!     {"step": 800, "op": "plastic", "halt": true}
-//!   ]
-//! }
-//! ```
-//!
-//! `rope` grabs the mass point nearest `at` (the paper's linear search); the
-//! rope's far end starts on that point and moves linearly to `to`, arriving
-//! at step `until` (default: at once); stiffness defaults to 50, rest length
-//! to 0. `extrude` / `trim` pick the boundary face / cell whose centroid is
-//! nearest `near` in the current control lattice. `plastic` makes the current
-//! shape the rest shape and, unless `"halt": false`, stops all motion.
+//! Plain JSON, documented with a runnable example in `docs/sculpt.md`
+//! (`{"dt": 0.002, "steps": 900, "material": {…}, "ops": [{"step": 0, "op":
+//! "rope", …}, …]}`); parsed and checked up front, before the first step, by
+//! [`super::sculpt_script`].
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -53,10 +29,11 @@ use subdyn::math::{Point3, Real};
 use subdyn::mesh::PolyMesh;
 use subdyn::solid::{MAX_SOLID_LEVEL, Solid, Stiffness};
 
-use super::common::{about_file, print_stdout, seconds, write_report};
+use super::common::{Written, about_file, seconds, write_report};
 use super::progress::Progress;
 use super::sculpt_script::{
-    MAX_STEPS, Op, Script, nearest_centroid, parse_script, read_script, selection, solid_params,
+    MAX_STEPS, Op, Script, check_script, extruded_face, parse_script, read_script, selection,
+    solid_params, trimmed_cell,
 };
 
 /// Which integrator steps the solid.
@@ -82,7 +59,7 @@ pub struct SculptArgs {
     /// Refinement level of the mass-point lattice (0 to 4).
     #[arg(long, value_name = "L", default_value_t = 2)]
     pub level: usize,
-    /// The session script (JSON; format in `subdyn sculpt`'s docs).
+    /// The session script (plain JSON; format and example in docs/sculpt.md).
     #[arg(
         long,
         value_name = "OPS.json",
@@ -144,18 +121,19 @@ pub fn run(args: &SculptArgs) -> anyhow::Result<()> {
         );
     }
     let (lattice, script, name) = if args.demo {
-        let script = parse_script(super::sculpt_demo::DEMO_SCRIPT, "the demo script")?;
-        (
-            super::sculpt_demo::demo_lattice()?,
-            script,
-            "demo cube".to_string(),
-        )
+        let what = "the demo script";
+        let script = parse_script(super::sculpt_demo::DEMO_SCRIPT, what)?;
+        let lattice = super::sculpt_demo::demo_lattice()?;
+        check_script(&script, &lattice, args.level, what)?;
+        (lattice, script, "demo cube".to_string())
     } else {
         let (Some(lat), Some(path)) = (&args.lattice, &args.script) else {
             anyhow::bail!("give a lattice and --script, or --demo");
         };
         let lattice = read_lattice(lat).map_err(|e| about_file(e, lat))?;
-        (lattice, read_script(path)?, lat.display().to_string())
+        let script = read_script(path)?;
+        check_script(&script, &lattice, args.level, &path.display().to_string())?;
+        (lattice, script, lat.display().to_string())
     };
     subdyn::io::create_output_dir(&args.out_dir)?;
     let progress = Progress::new(args.quiet);
@@ -192,9 +170,18 @@ pub fn run(args: &SculptArgs) -> anyhow::Result<()> {
         "ops": ops,
         "frames": frames,
     });
-    write_report(&args.out_dir.join("log.json"), &log)?;
-    let mut text = format!(
-        "subdyn sculpt: {name}, level {}, {} steps of {} s ({:?}), {} → {} mass points, {:.3} ms per step; {} frames and log.json in {}\n",
+    let mut written = Written::new();
+    for frame in &frames {
+        if let Some(step) = frame["step"].as_u64() {
+            let path = frame_path(&args.out_dir, step as usize);
+            written.add(&path, format!("frame, step {step}"));
+        }
+    }
+    let log_path = args.out_dir.join("log.json");
+    write_report(&log_path, &log)?;
+    written.add(&log_path, "log");
+    let text = format!(
+        "subdyn sculpt: {name}, level {}, {} steps of {} s ({:?}), {} → {} mass points, {:.3} ms per step; {} frames\n",
         args.level,
         script.steps,
         script.dt,
@@ -203,14 +190,13 @@ pub fn run(args: &SculptArgs) -> anyhow::Result<()> {
         solid.mass_points().len(),
         mean_ms,
         frames.len(),
-        args.out_dir.display()
     );
     if args.demo {
         let path = args.out_dir.join("sculpt_demo.png");
         super::sculpt_demo::write_strip(&snapshots, &path)?;
-        text.push_str(&format!("picture: {}\n", path.display()));
+        written.add(&path, "key frames picture");
     }
-    print_stdout(&text)
+    written.print_after(&text)
 }
 
 type SessionOutput = (Vec<Value>, Vec<Value>, Vec<Snapshot>, Vec<Real>);
@@ -231,13 +217,13 @@ fn session(
     let mut next_op = 0;
     let mut since_frame = (0.0, 0usize, 0usize); // (ms, steps, max CG iterations)
     for step in 0..=script.steps {
-        while next_op < script.ops.len() && script.ops[next_op].0 == step {
-            let op = &script.ops[next_op].1;
+        while next_op < script.ops.len() && script.ops[next_op].step == step {
+            let op = &script.ops[next_op];
             let t0 = Instant::now();
-            let detail = apply(solid, op, step, &mut moving)
-                .with_context(|| format!("script op {} at step {step}", op.name()))?;
+            let detail = apply(solid, &op.op, step, &mut moving)
+                .with_context(|| format!("script {}", op.label()))?;
             op_log.push(
-                json!({"step": step, "op": op.name(), "detail": detail, "ms": 1e3 * seconds(t0)}),
+                json!({"step": step, "op": op.op.name(), "detail": detail, "ms": 1e3 * seconds(t0)}),
             );
             next_op += 1;
         }
@@ -356,20 +342,7 @@ fn apply(
             format!("released {n} ropes")
         }
         Op::Extrude { face, near } => {
-            let lat = solid.control_lattice();
-            let t = &lat.topology;
-            let f = match (face, near) {
-                (Some(f), _) => *f,
-                (None, Some(q)) => nearest_centroid(
-                    &lat.positions,
-                    t.boundary_faces()
-                        .into_iter()
-                        .map(|f| (f as usize, t.faces.row(f as usize))),
-                    q,
-                )
-                .ok_or_else(|| anyhow::anyhow!("the lattice has no boundary face"))?,
-                (None, None) => anyhow::bail!("extrude needs \"face\" or \"near\""),
-            };
+            let f = extruded_face(&solid.control_lattice(), *face, near)?;
             solid.extrude(f)?;
             format!(
                 "extruded face {f}; {} cells",
@@ -377,18 +350,7 @@ fn apply(
             )
         }
         Op::Trim { cell, near } => {
-            let lat = solid.control_lattice();
-            let t = &lat.topology;
-            let c = match (cell, near) {
-                (Some(c), _) => *c,
-                (None, Some(q)) => nearest_centroid(
-                    &lat.positions,
-                    (0..t.num_cells()).map(|c| (c, t.cell_vertices.row(c))),
-                    q,
-                )
-                .ok_or_else(|| anyhow::anyhow!("the lattice has no cell"))?,
-                (None, None) => anyhow::bail!("trim needs \"cell\" or \"near\""),
-            };
+            let c = trimmed_cell(&solid.control_lattice(), *cell, near)?;
             solid.trim(c)?;
             format!(
                 "trimmed cell {c}; {} cells",

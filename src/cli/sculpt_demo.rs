@@ -95,6 +95,7 @@ pub fn write_strip(snapshots: &[Snapshot], path: &Path) -> anyhow::Result<()> {
                     ..CloudLayer::new(&fixed)
                 }]
             },
+            labels: Vec::new(),
         };
         let options = RenderOptions {
             width: w,

@@ -11,8 +11,8 @@ use subdyn::mesh::PolyMesh;
 use subdyn::subdivision::{check_uniform_size, uniform_positions};
 
 use super::common::{
-    about_file, bbox_json, check_mesh_output, check_output_dir, print_stdout, seconds, thousands,
-    timed, write_report,
+    Written, about_file, bbox_json, check_mesh_output, check_output_dir, seconds, thousands, timed,
+    write_report,
 };
 use super::options::{RefineArgs, read_polygon_mesh};
 use super::progress::Progress;
@@ -108,9 +108,11 @@ pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
     let (written, write_s) = timed(|| write_mesh(&args.output, &out, None));
     written.map_err(|e| about_file(e, &args.output))?;
     drop(progress);
+    let mut written = Written::new();
+    written.add(&args.output, "subdivided mesh");
 
     let summary = format!(
-        "{}{} to level {}{}: {} vertices, {} faces, written to {}\n",
+        "{}{} to level {}{}: {} vertices, {} faces\n",
         if args.input.is_none() {
             "no INPUT given: subdivided "
         } else {
@@ -125,7 +127,6 @@ pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
         },
         thousands(out.num_vertices()),
         thousands(out.num_faces()),
-        args.output.display()
     );
     if let Some(report) = &args.report {
         let counts: Vec<_> = hierarchy
@@ -157,8 +158,9 @@ pub fn run(args: &SubdivideArgs) -> anyhow::Result<()> {
             "bbox": bbox,
         });
         write_report(report, &value)?;
+        written.add(report, "report");
     }
-    print_stdout(&summary)
+    written.print_after(&summary)
 }
 
 /// `subdivide` with Doo-Sabin or non-uniform Catmull-Clark.
@@ -169,6 +171,8 @@ fn run_other(args: &SubdivideArgs, mesh: &PolyMesh, input_name: &str) -> anyhow:
     let out = refine_other(mesh, args.scheme, args.levels, args.knots.as_ref())
         .map_err(|e| e.context(input_name.to_string()))?;
     write_mesh(&args.output, &out, None).map_err(|e| about_file(e, &args.output))?;
+    let mut written = Written::new();
+    written.add(&args.output, "subdivided mesh");
     if let Some(report) = &args.report {
         let value = json!({
             "command": "subdivide",
@@ -181,14 +185,14 @@ fn run_other(args: &SubdivideArgs, mesh: &PolyMesh, input_name: &str) -> anyhow:
             "bbox": bbox_json(&out.positions),
         });
         write_report(report, &value)?;
+        written.add(report, "report");
     }
-    print_stdout(&format!(
-        "subdivided {input_name} with {} to level {}: {} vertices, {} faces, written to {}\n",
+    written.print_after(&format!(
+        "subdivided {input_name} with {} to level {}: {} vertices, {} faces\n",
         args.scheme.name(),
         args.levels,
         thousands(out.num_vertices()),
         thousands(out.num_faces()),
-        args.output.display()
     ))
 }
 

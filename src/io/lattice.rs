@@ -77,6 +77,39 @@ pub fn read_lattice(path: impl AsRef<Path>) -> Result<Lattice> {
     lattice_from_json(&bytes, path)
 }
 
+/// Whether `path` names lattice JSON rather than another JSON file (a raw
+/// volume's header, a sculpt script): a `.json` file holding an object with
+/// `"format": "subdyn-lattice"`, or with a `"vertices"` list and no
+/// `"format"`. An unreadable file is not a lattice (its reader then names
+/// the problem).
+///
+/// ```
+/// # let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("lat.json");
+/// std::fs::write(&path, r#"{"vertices": [], "hexahedra": []}"#).unwrap();
+/// assert!(subdyn::io::is_lattice_file(&path));
+/// std::fs::write(&path, r#"{"dims": [2, 2, 2], "dtype": "u8"}"#).unwrap();
+/// assert!(!subdyn::io::is_lattice_file(&path));
+/// ```
+pub fn is_lattice_file(path: &Path) -> bool {
+    let json = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    if !json {
+        return false;
+    }
+    let Ok(bytes) = super::read_input(path) else {
+        return false;
+    };
+    match serde_json::from_slice::<serde_json::Value>(&bytes) {
+        Ok(serde_json::Value::Object(map)) => match map.get("format") {
+            Some(f) => f == LATTICE_FORMAT,
+            None => map.get("vertices").is_some_and(serde_json::Value::is_array),
+        },
+        _ => false,
+    }
+}
+
 /// Parses lattice JSON; `path` only names the source in errors.
 pub fn lattice_from_json(bytes: &[u8], path: &Path) -> Result<Lattice> {
     let file: LatticeFile =

@@ -34,7 +34,8 @@ pub use batch::{OutputBatch, check_output_dir_path, create_output_dir};
 pub use creases::{ObjTags, SubdivisionTags, read_obj_tags, read_tags};
 pub use format::MeshFormat;
 pub use lattice::{
-    LATTICE_FORMAT, lattice_from_json, lattice_to_json, read_lattice, write_lattice,
+    LATTICE_FORMAT, is_lattice_file, lattice_from_json, lattice_to_json, read_lattice,
+    write_lattice,
 };
 pub use read::{
     read_mesh, read_mesh_from_bytes, read_obj_from_bytes, read_points, read_points_from_bytes,

@@ -114,11 +114,21 @@ impl Lattice {
     /// The boundary faces (those of one cell) as a polygon mesh over all the
     /// lattice's positions: the lattice's hull, e.g. to draw it.
     pub fn boundary_mesh(&self) -> Result<crate::mesh::PolyMesh> {
+        self.faces_mesh(self.topology.boundary_faces())
+    }
+
+    /// Every face, interior ones too, as a polygon mesh over all the
+    /// lattice's positions: its edges are the edges of every cell, e.g. to
+    /// draw the lattice as a cage.
+    pub fn all_faces_mesh(&self) -> Result<crate::mesh::PolyMesh> {
+        self.faces_mesh(0..self.topology.num_faces() as u32)
+    }
+
+    fn faces_mesh(&self, faces: impl IntoIterator<Item = u32>) -> Result<crate::mesh::PolyMesh> {
         let t = &self.topology;
-        let faces: Vec<Vec<u32>> = t
-            .boundary_faces()
-            .iter()
-            .map(|&f| t.faces.row(f as usize).to_vec())
+        let faces: Vec<Vec<u32>> = faces
+            .into_iter()
+            .map(|f| t.faces.row(f as usize).to_vec())
             .collect();
         crate::mesh::PolyMesh::from_faces(self.positions.clone(), &faces)
     }

@@ -1,5 +1,5 @@
 //! `render`: a scene to a picture — camera, faces, splats, edges,
-//! down-sampling, then legend and title at the final resolution.
+//! down-sampling, then labels, legend and title at the final resolution.
 
 use std::collections::HashSet;
 
@@ -9,6 +9,7 @@ use crate::math::{Point3, Real, Vector3, bbox_diagonal, bounding_box};
 use super::camera::{Camera, ScreenPoint};
 use super::colormap::normalise;
 use super::eye_dome::eye_dome;
+use super::font::draw_text;
 use super::legend::{Legend, draw_title, title_height};
 use super::marks::{draw_disk, draw_line};
 use super::picture::{Picture, Rgb};
@@ -29,7 +30,7 @@ const BACK_SHADE: f32 = 0.75;
 /// the legend strip). Faces are fan-triangulated and shaded per pixel
 /// (Lambert, headlight, two-sided: back sides get [`RenderOptions`]'s back
 /// colour), points are depth-tested disks (with eye-dome lighting when they
-/// have no normals), edges are drawn last. When a layer
+/// have no normals), edges are drawn last, then the labels on top. When a layer
 /// has scalars, a legend bar for the scalar range is drawn at the right.
 ///
 /// ```
@@ -119,6 +120,23 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Picture> {
     }
 
     let mut picture = downsample(&target, k)?;
+    let label_scale = text_scale;
+    for label in &scene.labels {
+        let p = camera.project(&label.at);
+        if p.x.is_finite() && p.y.is_finite() && p.x.abs() < 1e6 && p.y.abs() < 1e6 {
+            let (x, y) = ((p.x / kf).round() as i64, (p.y / kf).round() as i64);
+            let up = i64::from(8 * label_scale);
+            let s = i64::from(label_scale);
+            draw_text(
+                &mut picture,
+                x + 2 * s,
+                y - up,
+                &label.text,
+                label_scale,
+                label.color,
+            );
+        }
+    }
     if let Some(legend) = legend {
         legend.draw(
             &mut picture,

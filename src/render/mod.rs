@@ -47,7 +47,8 @@ pub use legend::{nice_ticks, tick_labels};
 pub use picture::{MAX_SIDE, Picture, Rgb, check_png_path, write_png};
 pub use plot::{Series, line_plot, series_color};
 pub use scene::{
-    BACK, CloudLayer, EDGES, MAX_WORK_PIXELS, MeshLayer, POINTS, RenderOptions, SURFACE, Scene,
+    BACK, CloudLayer, EDGES, LABELS, Label, MAX_WORK_PIXELS, MeshLayer, POINTS, RenderOptions,
+    SURFACE, Scene,
 };
 pub use shading::{AMBIENT, corner_normals, face_normals};
 pub use slices::slice_overlay;

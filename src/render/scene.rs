@@ -1,7 +1,8 @@
-//! What to draw (`Scene` of mesh and point layers) and how (`RenderOptions`).
+//! What to draw (`Scene` of mesh and point layers, and labels) and how
+//! (`RenderOptions`).
 
 use crate::error::{Error, Result};
-use crate::math::{Real, Vector3};
+use crate::math::{Point3, Real, Vector3};
 use crate::mesh::{PointCloud, PolyMesh};
 
 use super::camera::Projection;
@@ -113,6 +114,43 @@ impl<'a> CloudLayer<'a> {
     }
 }
 
+/// A short text drawn just right of and above a point, on top of everything
+/// (not depth-tested), e.g. a control point's number.
+///
+/// ```
+/// use subdyn::math::Point3;
+/// use subdyn::render::{render, Label, MeshLayer, RenderOptions, Scene, EDGES};
+/// let cube = subdyn::examples::cube();
+/// let labels = vec![Label::new(cube.positions[0], "0")];
+/// let scene = Scene { meshes: vec![MeshLayer::wireframe(&cube, EDGES)], labels, ..Scene::default() };
+/// let picture = render(&scene, &RenderOptions { width: 64, height: 48, ..Default::default() })?;
+/// assert!(picture.count(|c| c == EDGES) > 0);
+/// # Ok::<(), subdyn::Error>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct Label {
+    /// The point labelled.
+    pub at: Point3,
+    /// The text (the bitmap font's characters).
+    pub text: String,
+    /// Its colour (default [`LABELS`]).
+    pub color: Rgb,
+}
+
+/// Default colour of labels (a dark red).
+pub const LABELS: Rgb = [170, 20, 20];
+
+impl Label {
+    /// A label in the default colour.
+    pub fn new(at: Point3, text: impl Into<String>) -> Self {
+        Label {
+            at,
+            text: text.into(),
+            color: LABELS,
+        }
+    }
+}
+
 /// Everything to draw.
 #[derive(Clone, Debug, Default)]
 pub struct Scene<'a> {
@@ -120,6 +158,8 @@ pub struct Scene<'a> {
     pub meshes: Vec<MeshLayer<'a>>,
     /// Point clouds.
     pub clouds: Vec<CloudLayer<'a>>,
+    /// Labels, drawn last.
+    pub labels: Vec<Label>,
 }
 
 /// How to draw a [`Scene`]. Every field has a default (see [`Default`]).

@@ -38,7 +38,7 @@ pub mod tools;
 pub use edit::{extrude_face, extruded_topology, extrusion_offset, trim_cell, trimmed_topology};
 pub use explicit::StepReport;
 pub use model::{MAX_SOLID_LEVEL, Solid, lumped_masses};
-pub use params::{ExplicitScheme, ImplicitPreconditioner, SolidParams};
+pub use params::{ExplicitScheme, ImplicitPreconditioner, SolidParams, check_value};
 pub use reduced::MAX_DENSE_UNKNOWNS;
 pub use springs::{SpringHessians, SpringNetwork, Stiffness};
 pub use tools::Rope;

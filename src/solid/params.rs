@@ -88,8 +88,10 @@ impl Default for SolidParams {
     }
 }
 
-/// Errors unless `x` is finite and `≥ 0` (or `> 0` when `positive`).
-pub(crate) fn check_value(name: &str, x: Real, positive: bool) -> Result<()> {
+/// Errors unless `x` is finite, at most 1e12 and `≥ 0` (or `> 0` when
+/// `positive`); `name` names the value in the message. Every stiffness,
+/// damping, density and rope value of a solid is checked with it.
+pub fn check_value(name: &str, x: Real, positive: bool) -> Result<()> {
     let ok = x.is_finite() && if positive { x > 0.0 } else { x >= 0.0 };
     if !ok || x > 1e12 {
         return Err(Error::Input(format!(
