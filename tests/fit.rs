@@ -423,3 +423,56 @@ fn a_thin_horn_does_not_tangle_the_limit_surface() {
     assert!(u.largest_move < 0.02 * after.report.diameter, "{u:?}");
     assert_eq!(pairs, 0, "{warnings:?}");
 }
+
+/// The untangling's re-check, which evaluates again only the faces whose
+/// limit surface moved and tests again only the triangles that moved, gives
+/// what a check from scratch gives (points, normals, pairs), on a cube
+/// refined once with a corner pushed through the opposite side and then
+/// some points moved back; triangles and quads mixed in the cage.
+#[test]
+fn the_untangling_re_check_equals_a_check_from_scratch() {
+    use subdyn::fit::quality::SelfIntersections;
+    let cube = subdyn::examples::cube();
+    let h = Refiner::new(&cube, &RefineOptions::default())
+        .unwrap()
+        .refine_uniform(1)
+        .unwrap();
+    let mut mesh = h.mesh(1, h.stencil(0).apply(&cube.positions).unwrap());
+    // One quad split into two triangles, so the tiles are sub-faces.
+    let f0 = mesh.face(0).to_vec();
+    let mut faces: Vec<Vec<u32>> = (1..mesh.num_faces())
+        .map(|f| mesh.face(f).to_vec())
+        .collect();
+    faces.push(vec![f0[0], f0[1], f0[2]]);
+    faces.push(vec![f0[0], f0[2], f0[3]]);
+    mesh = PolyMesh::from_faces(mesh.positions.clone(), &faces).unwrap();
+    let refiner = Refiner::new(&mesh, &RefineOptions::default()).unwrap();
+    let start = SelfIntersections::of(&refiner, &mesh.positions, 4).unwrap();
+    assert!(start.pairs.is_empty(), "the cube does not cross itself");
+    let centre = Point3::from(
+        mesh.positions.iter().map(|p| p.coords).sum::<Vector3>() / mesh.num_vertices() as Real,
+    );
+    let mut pushed = mesh.positions.clone();
+    let corner = (0..pushed.len())
+        .max_by(|&a, &b| {
+            (pushed[a] - centre)
+                .norm()
+                .total_cmp(&(pushed[b] - centre).norm())
+        })
+        .unwrap();
+    pushed[corner] = centre + 3.0 * (centre - pushed[corner]);
+    let mut back = pushed.clone();
+    back[corner] = mesh.positions[corner] + Vector3::new(0.01, 0.0, 0.0);
+    let moved = start.moved(&refiner, &pushed).unwrap();
+    let again = moved.moved(&refiner, &back).unwrap();
+    for (got, p) in [(&moved, &pushed), (&again, &back)] {
+        let fresh = SelfIntersections::of(&refiner, p, 4).unwrap();
+        assert_eq!(got.positions, fresh.positions);
+        assert_eq!(got.normals, fresh.normals);
+        assert_eq!(got.pairs, fresh.pairs);
+    }
+    assert!(
+        !moved.pairs.is_empty(),
+        "the pushed corner must cross the cube"
+    );
+}

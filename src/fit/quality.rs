@@ -35,14 +35,14 @@
 //! the size and where (the bounding box of the largest connected far
 //! region, or of the points), printed by `subdyn fit` and kept in the report.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, PoisonError};
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::error::Result;
-use crate::limit::tessellate;
+use crate::limit::{PatchTable, Tessellation};
 use crate::math::{Point3, Real, Vector3, bounding_box, polygon_folds};
 use crate::mesh::PolyMesh;
 use crate::metrics::TriangleBvh;
@@ -239,16 +239,30 @@ pub struct SelfIntersections {
     pub face: Vec<u32>,
     /// Intersecting pairs (indices into [`triangles`](Self::triangles)).
     pub pairs: Vec<[u32; 2]>,
-    /// The first check ([`of`](Self::of)): its hierarchy, pairs and rate,
-    /// which [`moved`](Self::moved) updates.
-    first: Arc<(TriangleBvh, Vec<[u32; 2]>, usize)>,
+    /// The control points checked.
+    control: Vec<Point3>,
+    /// The first check ([`of`](Self::of)), which [`moved`](Self::moved)
+    /// updates.
+    first: Arc<FirstCheck>,
+}
+
+/// What [`SelfIntersections::moved`] needs of the first check: its
+/// hierarchy and pairs, the tessellation's topology and the patch table.
+struct FirstCheck {
+    bvh: TriangleBvh,
+    pairs: Vec<[u32; 2]>,
+    plan: Tessellation,
+    table: Mutex<PatchTable>,
 }
 
 impl SelfIntersections {
     /// The tessellation of the limit surface of `refiner`'s mesh with
     /// control points `positions`, and its self-intersections.
     pub fn of(refiner: &Refiner, positions: &[Point3], rate: usize) -> Result<Self> {
-        let (mesh, normals) = tessellate(refiner, positions, rate)?;
+        let plan = Tessellation::new(refiner, rate)?;
+        let table = PatchTable::new(refiner, positions, 1)?;
+        let (points, normals) = plan.evaluate(&table, None)?;
+        let mesh = plan.mesh(points)?;
         let level = &refiner.level;
         // `tessellate` gives every face one tile when all are quads, else
         // one per corner, each rate² quads in tile order.
@@ -277,29 +291,62 @@ impl SelfIntersections {
             normals,
             face,
             pairs: pairs.clone(),
-            first: Arc::new((bvh, pairs, rate)),
+            control: positions.to_vec(),
+            first: Arc::new(FirstCheck {
+                bvh,
+                pairs,
+                plan,
+                table: Mutex::new(table),
+            }),
         })
     }
 
     /// The same check after the control points moved to `positions`: the
-    /// pairs [`of`](Self::of) would give, found by testing again only the
-    /// tessellation triangles that moved
-    /// ([`TriangleBvh::self_intersections_moved`]).
+    /// pairs [`of`](Self::of) would give. Only the faces whose limit surface
+    /// moved (those with a vertex sharing a face with a moved control point)
+    /// are evaluated again, and only the triangles that moved are tested
+    /// again ([`TriangleBvh::self_intersections_moved`]).
     pub fn moved(&self, refiner: &Refiner, positions: &[Point3]) -> Result<Self> {
-        let (bvh, pairs, rate) = &*self.first;
-        let (mesh, normals) = tessellate(refiner, positions, *rate)?;
+        let level = &refiner.level;
+        let moved: Vec<bool> = self
+            .control
+            .iter()
+            .zip(positions)
+            .map(|(a, b)| a != b)
+            .collect();
+        let mut near = vec![false; level.num_vertices];
+        for f in 0..level.num_faces() {
+            let fv = level.face_vertices(f);
+            if fv.iter().any(|&v| moved[v as usize]) {
+                for &v in fv {
+                    near[v as usize] = true;
+                }
+            }
+        }
+        let faces: Vec<bool> = (0..level.num_faces())
+            .map(|f| level.face_vertices(f).iter().any(|&v| near[v as usize]))
+            .collect();
+        let first = &*self.first;
+        // A poisoned lock still holds a whole table: `set_positions` below
+        // overwrites every position it uses.
+        let mut table = first.table.lock().unwrap_or_else(PoisonError::into_inner);
+        table.set_positions(positions)?;
+        let (points, normals) = first
+            .plan
+            .evaluate(&table, Some((&faces, &self.positions, &self.normals)))?;
         Ok(SelfIntersections {
-            pairs: bvh.self_intersections_moved(pairs, &mesh.positions)?,
-            positions: mesh.positions,
+            pairs: first.bvh.self_intersections_moved(&first.pairs, &points)?,
+            positions: points,
             normals,
             face: self.face.clone(),
+            control: positions.to_vec(),
             first: self.first.clone(),
         })
     }
 
     /// Tessellation triangles (indices into `positions`).
     pub fn triangles(&self) -> &[[u32; 3]] {
-        self.first.0.triangles()
+        self.first.bvh.triangles()
     }
 
     /// Per control face of the mesh (`num_faces` of them): whether a

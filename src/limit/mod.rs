@@ -19,5 +19,5 @@ pub use limit_stencil::{limit_stencil, limit_tangent_stencils};
 pub use patch::SampleStencil;
 pub(crate) use patch_table::chain as chain_rule;
 pub use patch_table::{PatchPoint, PatchTable, QuadtreeCache, TREE_DEPTH};
-pub use tessellate::{limit_surface_mesh, tessellate};
+pub use tessellate::{Tessellation, limit_surface_mesh, tessellate};
 pub use vertex_masks::CornerKind;

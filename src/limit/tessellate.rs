@@ -64,11 +64,7 @@ pub fn tessellate(
     positions: &[Point3],
     k: usize,
 ) -> Result<(PolyMesh, Vec<Vector3>)> {
-    if k == 0 || k > 1024 {
-        return Err(Error::Input(format!(
-            "tessellation rate {k} must be between 1 and 1024"
-        )));
-    }
+    let plan = Tessellation::new(refiner, k)?;
     let level = &refiner.level;
     if positions.len() != level.num_vertices {
         return Err(Error::Input(format!(
@@ -78,90 +74,146 @@ pub fn tessellate(
         )));
     }
     let table = PatchTable::new(refiner, positions, 1)?;
-    let split = (0..level.num_faces()).any(|f| level.face_vertices(f).len() != 4);
-    let mut tiles = Vec::new();
-    // Hole faces are left out (they still shape their neighbours).
-    for f in (0..level.num_faces()).filter(|&f| !refiner.holes.get(f).copied().unwrap_or(false)) {
-        let fv = level.face_vertices(f);
-        let fe = level.face_edge_list(f);
-        let n = fv.len();
-        if !split {
-            tiles.push(Tile {
-                face: f as u32,
-                origin: [0.0, 0.0],
-                size: 1.0,
-                corners: [0, 1, 2, 3].map(|i| Corner::Vertex(fv[i])),
-            });
-            continue;
+    let (pts, normals) = plan.evaluate(&table, None)?;
+    Ok((plan.mesh(pts)?, normals))
+}
+
+/// The topology of a [`tessellate`]d surface: its tiles, its quads, and the
+/// tile sample each vertex is evaluated at, so that the samples can be
+/// evaluated again, all or those of some faces, when the control points
+/// move.
+pub struct Tessellation {
+    tiles: Vec<Tile>,
+    /// Per vertex: the tile and grid sample it is evaluated at.
+    owner: Vec<(u32, u32)>,
+    faces: Vec<Vec<u32>>,
+    k: usize,
+}
+
+impl Tessellation {
+    /// The tessellation of `refiner`'s mesh, `k × k` per quad (tile).
+    pub fn new(refiner: &Refiner, k: usize) -> Result<Self> {
+        if k == 0 || k > 1024 {
+            return Err(Error::Input(format!(
+                "tessellation rate {k} must be between 1 and 1024"
+            )));
         }
-        let d = (n as Real).sqrt().ceil() as usize;
-        for i in 0..n {
-            let sub = [
-                Corner::Vertex(fv[i]),
-                Corner::Mid(fe[i]),
-                Corner::Centre(f as u32),
-                Corner::Mid(fe[(i + n - 1) % n]),
-            ];
-            let (origin, size, corners) = if n == 4 {
-                // A quad's sub-face i in its own (u, v): corner i's quadrant.
-                let c = [[0.0, 0.0], [0.5, 0.0], [0.5, 0.5], [0.0, 0.5]][i];
-                // Rotate the corner list so corner 0 sits at the quadrant's (0, 0).
-                let rot = [[0, 1, 2, 3], [3, 0, 1, 2], [2, 3, 0, 1], [1, 2, 3, 0]][i];
-                (c, 0.5, rot.map(|r| sub[r]))
-            } else {
-                ([(i % d) as Real, (i / d) as Real], 0.5, sub)
-            };
-            tiles.push(Tile {
-                face: f as u32,
-                origin,
-                size,
-                corners,
-            });
-        }
-    }
-    // Weld by topological key: a sample shared by several tiles (an edge's,
-    // a corner's) is one vertex, evaluated once, in the first tile that
-    // has it.
-    let mut index: HashMap<Key, u32> = HashMap::new();
-    // Per vertex: the tile and grid sample it is evaluated at.
-    let mut owner: Vec<(u32, u32)> = Vec::new();
-    let mut faces: Vec<Vec<u32>> = Vec::with_capacity(tiles.len() * k * k);
-    let mut ids = vec![0u32; (k + 1) * (k + 1)];
-    for (t, tile) in tiles.iter().enumerate() {
-        for b in 0..=k {
-            for a in 0..=k {
-                let sample = b * (k + 1) + a;
-                let mut new = || {
-                    owner.push((t as u32, sample as u32));
-                    (owner.len() - 1) as u32
+        let level = &refiner.level;
+        let split = (0..level.num_faces()).any(|f| level.face_vertices(f).len() != 4);
+        let mut tiles = Vec::new();
+        // Hole faces are left out (they still shape their neighbours).
+        for f in (0..level.num_faces()).filter(|&f| !refiner.holes.get(f).copied().unwrap_or(false))
+        {
+            let fv = level.face_vertices(f);
+            let fe = level.face_edge_list(f);
+            let n = fv.len();
+            if !split {
+                tiles.push(Tile {
+                    face: f as u32,
+                    origin: [0.0, 0.0],
+                    size: 1.0,
+                    corners: [0, 1, 2, 3].map(|i| Corner::Vertex(fv[i])),
+                });
+                continue;
+            }
+            let d = (n as Real).sqrt().ceil() as usize;
+            for i in 0..n {
+                let sub = [
+                    Corner::Vertex(fv[i]),
+                    Corner::Mid(fe[i]),
+                    Corner::Centre(f as u32),
+                    Corner::Mid(fe[(i + n - 1) % n]),
+                ];
+                let (origin, size, corners) = if n == 4 {
+                    // A quad's sub-face i in its own (u, v): corner i's quadrant.
+                    let c = [[0.0, 0.0], [0.5, 0.0], [0.5, 0.5], [0.0, 0.5]][i];
+                    // Rotate the corner list so corner 0 sits at the quadrant's (0, 0).
+                    let rot = [[0, 1, 2, 3], [3, 0, 1, 2], [2, 3, 0, 1], [1, 2, 3, 0]][i];
+                    (c, 0.5, rot.map(|r| sub[r]))
+                } else {
+                    ([(i % d) as Real, (i / d) as Real], 0.5, sub)
                 };
-                ids[sample] = match sample_key(tile, a, b, k) {
-                    Some(key) => *index.entry(key).or_insert_with(new),
-                    None => new(),
-                };
+                tiles.push(Tile {
+                    face: f as u32,
+                    origin,
+                    size,
+                    corners,
+                });
             }
         }
-        for b in 0..k {
-            for a in 0..k {
-                let i = |a: usize, b: usize| ids[b * (k + 1) + a];
-                faces.push(vec![i(a, b), i(a + 1, b), i(a + 1, b + 1), i(a, b + 1)]);
+        // Weld by topological key: a sample shared by several tiles (an edge's,
+        // a corner's) is one vertex, evaluated once, in the first tile that
+        // has it.
+        let mut index: HashMap<Key, u32> = HashMap::new();
+        // Per vertex: the tile and grid sample it is evaluated at.
+        let mut owner: Vec<(u32, u32)> = Vec::new();
+        let mut faces: Vec<Vec<u32>> = Vec::with_capacity(tiles.len() * k * k);
+        let mut ids = vec![0u32; (k + 1) * (k + 1)];
+        for (t, tile) in tiles.iter().enumerate() {
+            for b in 0..=k {
+                for a in 0..=k {
+                    let sample = b * (k + 1) + a;
+                    let mut new = || {
+                        owner.push((t as u32, sample as u32));
+                        (owner.len() - 1) as u32
+                    };
+                    ids[sample] = match sample_key(tile, a, b, k) {
+                        Some(key) => *index.entry(key).or_insert_with(new),
+                        None => new(),
+                    };
+                }
+            }
+            for b in 0..k {
+                for a in 0..k {
+                    let i = |a: usize, b: usize| ids[b * (k + 1) + a];
+                    faces.push(vec![i(a, b), i(a + 1, b), i(a + 1, b + 1), i(a, b + 1)]);
+                }
             }
         }
-    }
-    let (pts, normals): (Vec<Point3>, Vec<Vector3>) = owner
-        .par_iter()
-        .map(|&(t, sample)| {
-            let t = &tiles[t as usize];
-            let (a, b) = (sample as usize % (k + 1), sample as usize / (k + 1));
-            let u = t.origin[0] + t.size * a as Real / k as Real;
-            let v = t.origin[1] + t.size * b as Real / k as Real;
-            let s = table.evaluate(t.face as usize, u, v)?;
-            Ok((s.p, s.normal()))
+        Ok(Tessellation {
+            tiles,
+            owner,
+            faces,
+            k,
         })
-        .collect::<Result<Vec<_>>>()?
-        .into_iter()
-        .unzip();
-    Ok((PolyMesh::from_faces(pts, &faces)?, normals))
+    }
+
+    /// Every vertex's position and unit normal on `table`; with `keep =
+    /// Some((faces, positions, normals))`, only the vertices evaluated on a
+    /// tile of a marked control face, the others copied from `positions`
+    /// and `normals` (the same surface there).
+    pub fn evaluate(
+        &self,
+        table: &PatchTable,
+        keep: Option<(&[bool], &[Point3], &[Vector3])>,
+    ) -> Result<(Vec<Point3>, Vec<Vector3>)> {
+        let k = self.k;
+        Ok(self
+            .owner
+            .par_iter()
+            .enumerate()
+            .map(|(i, &(t, sample))| {
+                let t = &self.tiles[t as usize];
+                if let Some((faces, p, n)) = keep
+                    && !faces[t.face as usize]
+                {
+                    return Ok((p[i], n[i]));
+                }
+                let (a, b) = (sample as usize % (k + 1), sample as usize / (k + 1));
+                let u = t.origin[0] + t.size * a as Real / k as Real;
+                let v = t.origin[1] + t.size * b as Real / k as Real;
+                let s = table.evaluate(t.face as usize, u, v)?;
+                Ok((s.p, s.normal()))
+            })
+            .collect::<Result<Vec<_>>>()?
+            .into_iter()
+            .unzip())
+    }
+
+    /// The quad mesh of the vertices `positions` (from [`evaluate`](Self::evaluate)).
+    pub fn mesh(&self, positions: Vec<Point3>) -> Result<PolyMesh> {
+        PolyMesh::from_faces(positions, &self.faces)
+    }
 }
 
 /// The shared key of grid sample `(a, b)` of a tile, `None` for interior samples.
