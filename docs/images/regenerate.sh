@@ -47,6 +47,20 @@ done_picture() {
     echo "== $images/$1 regenerated"
     made+=("$1")
 }
+# middle_axial DIR: the middle one of the axial slice pictures that
+# `subdyn recover --slices-png DIR` wrote (their z follows the result).
+middle_axial() {
+    local files f n
+    mapfile -t files < <(for f in "$1"/axial_z*.png; do
+        n=${f##*/axial_z}
+        echo "${n%.png} $f"
+    done | sort -g | cut -d' ' -f2-)
+    if [[ ! -e ${files[0]:-} ]]; then
+        echo "regenerate.sh: no axial slice picture in $1" >&2
+        return 1
+    fi
+    echo "${files[$((${#files[@]} / 2))]}"
+}
 selection=("$@")
 
 if wanted spot.png && needs_shared spot.png; then
@@ -149,7 +163,7 @@ if wanted recover_genus2_slice.png; then
         --spacing 0.045,0.045,0.06 --blur 0.03 --noise 0.05
     subdyn recover "$tmp/g2/genus2.json" --iso 0.5 -o "$tmp/g2/fit.obj" \
         --slices-png "$tmp/g2/sl" --quiet
-    cp "$tmp/g2/sl/axial_z0.0.png" $images/recover_genus2_slice.png
+    cp "$(middle_axial "$tmp/g2/sl")" $images/recover_genus2_slice.png
     done_picture recover_genus2_slice.png
 fi
 
@@ -157,7 +171,7 @@ if wanted recover_mni_ventricle.png && needs_shared recover_mni_ventricle.png; t
     subdyn recover "$shared/volumes/mni_icbm152_t1_tal_nlin_sym_09a_converted.nii.gz" \
         --auto --seed -6,0,18 --dark --iso 120 -o "$tmp/ventricle.obj" \
         --slices-png "$tmp/vs" --quiet
-    cp "$tmp/vs/axial_z12.8.png" $images/recover_mni_ventricle.png
+    cp "$(middle_axial "$tmp/vs")" $images/recover_mni_ventricle.png
     done_picture recover_mni_ventricle.png
 fi
 
