@@ -1,13 +1,16 @@
 //! Refine the embedded unit cube three levels with one composed stencil table
 //! and move the result to the limit surface.
 //!
-//! Inputs: none (the cube is built in). Output: `cube_l3_limit.obj` in the
-//! current directory. Run with `cargo run --release --example 01_refine_cube`.
+//! Inputs: none (the cube is built in). Output: `cube_l3_limit.obj` in
+//! `target/examples-out/`. Run with `cargo run --release --example 01_refine_cube`.
+
+mod common;
 
 use subdyn::limit::limit_stencil;
 use subdyn::subdivision::{RefineOptions, Refiner};
 
 fn main() -> subdyn::Result<()> {
+    let out = common::output_dir()?;
     let cage = subdyn::examples::cube();
     // Topology once, without positions.
     let refiner = Refiner::new(&cage, &RefineOptions::default())?;
@@ -23,7 +26,8 @@ fn main() -> subdyn::Result<()> {
     );
     let on_limit = limit.apply(&cage.positions)?;
     let mesh = hierarchy.mesh(3, on_limit);
-    subdyn::io::write_mesh("cube_l3_limit.obj", &mesh, None)?;
-    println!("wrote cube_l3_limit.obj");
+    let path = out.join("cube_l3_limit.obj");
+    subdyn::io::write_mesh(&path, &mesh, None)?;
+    println!("wrote {}", path.display());
     Ok(())
 }

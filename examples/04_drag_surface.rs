@@ -5,12 +5,14 @@
 //! spring attachment) and by conjugate gradients, to compare.
 //!
 //! Inputs: a control mesh (`.obj`, `.ply`, `.off`), default the cube
-//! refined four times (1,538 control points). Outputs in the current
-//! directory: `drag_surface.obj` (the control mesh at the end of the drag)
+//! refined four times (1,538 control points). Outputs in
+//! `target/examples-out/`: `drag_surface.obj` (the control mesh at the end of the drag)
 //! and `drag_surface.png` (rest, dragged, released). Prints per phase the
 //! time per step of either solver, the factorisations, the largest
 //! difference between the two solvers' control points and the energy.
 //! Run with `cargo run --release --example 04_drag_surface [MESH]`.
+
+mod common;
 
 use std::time::Instant;
 
@@ -45,6 +47,7 @@ fn picture(mesh: &PolyMesh, positions: &[Point3], title: &str) -> subdyn::Result
 }
 
 fn main() -> subdyn::Result<()> {
+    let out = common::output_dir()?;
     let mesh = match std::env::args().nth(1) {
         Some(path) => read_mesh(std::path::Path::new(&path))?,
         None => {
@@ -144,13 +147,15 @@ fn main() -> subdyn::Result<()> {
                 positions: solvers[0].positions().to_vec(),
                 ..mesh.clone()
             };
-            write_mesh(std::path::Path::new("drag_surface.obj"), &dragged, None)?;
+            write_mesh(out.join("drag_surface.obj"), &dragged, None)?;
         }
     }
     write_png(
-        std::path::Path::new("drag_surface.png"),
+        &out.join("drag_surface.png"),
         &Picture::side_by_side(&frames)?,
     )?;
-    println!("wrote drag_surface.obj and drag_surface.png");
+    for name in ["drag_surface.obj", "drag_surface.png"] {
+        println!("wrote {}", out.join(name).display());
+    }
     Ok(())
 }

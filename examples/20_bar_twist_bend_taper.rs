@@ -1,10 +1,12 @@
 //! Twist, bend and taper a bar with a 4×1×1 box lattice refined three times
 //! (MacCracken & Joy 1996). The bar is the boundary of a 32×8×8 grid.
 //!
-//! Inputs: none. Outputs in the current directory: `bar_twist.obj`,
+//! Inputs: none. Outputs in `target/examples-out/`: `bar_twist.obj`,
 //! `bar_bend.obj`, `bar_taper.obj` and `bar_deformations.png` (the rest bar
 //! and the three deformations side by side, lattices as wireframes).
 //! Run with `cargo run --release --example 20_bar_twist_bend_taper`.
+
+mod common;
 
 use subdyn::ffd::{Ffd, FfdParams};
 use subdyn::lattice::box_grid;
@@ -22,6 +24,7 @@ fn shifted(mesh: &PolyMesh, positions: &[Point3], dy: f64) -> PolyMesh {
 }
 
 fn main() -> subdyn::Result<()> {
+    let out = common::output_dir()?;
     let (len, w) = (4.0, 1.0);
     let bar = box_grid(
         Point3::new(0.0, 0.0, 0.0),
@@ -83,8 +86,9 @@ fn main() -> subdyn::Result<()> {
     {
         let moved = ffd.deform(ctrl)?;
         let mesh = shifted(&bar, &moved, 0.0);
-        subdyn::io::write_mesh(format!("bar_{name}.obj"), &mesh, None)?;
-        println!("wrote bar_{name}.obj");
+        let path = out.join(format!("bar_{name}.obj"));
+        subdyn::io::write_mesh(&path, &mesh, None)?;
+        println!("wrote {}", path.display());
         let dy = 2.0 * (k + 1) as f64;
         meshes.push(shifted(&bar, &moved, dy));
         cages.push(shifted(&lat.boundary_mesh()?, ctrl, dy));
@@ -105,10 +109,8 @@ fn main() -> subdyn::Result<()> {
         title: Some("rest, twist, bend, taper (4x1x1 lattice, 3 levels)".into()),
         ..Default::default()
     };
-    write_png(
-        std::path::Path::new("bar_deformations.png"),
-        &render(&scene, &options)?,
-    )?;
-    println!("wrote bar_deformations.png");
+    let path = out.join("bar_deformations.png");
+    write_png(&path, &render(&scene, &options)?)?;
+    println!("wrote {}", path.display());
     Ok(())
 }

@@ -5,9 +5,11 @@
 //! hexahedron); every vertex of it has valence 3, so refinement makes
 //! hexahedra only, ten of them around the axis (an extraordinary edge).
 //!
-//! Inputs: none. Outputs in the current directory: `disc_star.obj` (the
+//! Inputs: none. Outputs in `target/examples-out/`: `disc_star.obj` (the
 //! deformed disc) and `disc_star.png` (rest disc and star, lattices as
 //! wireframes). Run with `cargo run --release --example 21_star_disc`.
+
+mod common;
 
 use subdyn::ffd::{Ffd, FfdParams};
 use subdyn::lattice::cylinder;
@@ -61,6 +63,7 @@ fn disc(r: f64, z0: f64, z1: f64, rings: usize, segments: usize) -> subdyn::Resu
 }
 
 fn main() -> subdyn::Result<()> {
+    let out_dir = common::output_dir()?;
     let model = disc(1.0, 0.1, 0.4, 24, 96)?;
     let segments = 10;
     let lat = cylinder(1.4, 0.5, segments, 1)?;
@@ -91,8 +94,9 @@ fn main() -> subdyn::Result<()> {
     let moved = ffd.deform(&star)?;
     let mut out = model.clone();
     out.positions = moved;
-    subdyn::io::write_mesh("disc_star.obj", &out, None)?;
-    println!("wrote disc_star.obj");
+    let path = out_dir.join("disc_star.obj");
+    subdyn::io::write_mesh(&path, &out, None)?;
+    println!("wrote {}", path.display());
     let shift = |m: &PolyMesh, pos: &[Point3], dx: f64| {
         let mut m = m.clone();
         m.positions = pos.iter().map(|p| p + Vector3::new(dx, 0.0, 0.0)).collect();
@@ -120,10 +124,8 @@ fn main() -> subdyn::Result<()> {
         title: Some("disc in a 10-segment cylinder lattice: rest and star (3 levels)".into()),
         ..Default::default()
     };
-    write_png(
-        std::path::Path::new("disc_star.png"),
-        &render(&scene, &options)?,
-    )?;
-    println!("wrote disc_star.png");
+    let path = out_dir.join("disc_star.png");
+    write_png(&path, &render(&scene, &options)?)?;
+    println!("wrote {}", path.display());
     Ok(())
 }

@@ -4,9 +4,11 @@
 //! a dumbbell surface. The right block is turned a quarter turn about the
 //! bar's axis and lifted; the handle carries the twist and the bend.
 //!
-//! Inputs: none. Outputs in the current directory: `barbell.obj` (the
+//! Inputs: none. Outputs in `target/examples-out/`: `barbell.obj` (the
 //! deformed dumbbell) and `barbell.png` (rest and deformed, lattices as
 //! wireframes). Run with `cargo run --release --example 22_barbell`.
+
+mod common;
 
 use subdyn::ffd::{Ffd, FfdParams};
 use subdyn::lattice::hexahedra;
@@ -58,6 +60,7 @@ fn dumbbell(n: usize, m: usize) -> subdyn::Result<PolyMesh> {
 }
 
 fn main() -> subdyn::Result<()> {
+    let out_dir = common::output_dir()?;
     // The cells of a 9×3×3 grid kept: both blocks and the handle's middle column.
     let id = |i: usize, j: usize, k: usize| (i + 10 * (j + 4 * k)) as u32;
     let mut all = Vec::new();
@@ -131,8 +134,9 @@ fn main() -> subdyn::Result<()> {
     let moved = ffd.deform(&moved_lattice)?;
     let mut out = model.clone();
     out.positions = moved;
-    subdyn::io::write_mesh("barbell.obj", &out, None)?;
-    println!("wrote barbell.obj");
+    let path = out_dir.join("barbell.obj");
+    subdyn::io::write_mesh(&path, &out, None)?;
+    println!("wrote {}", path.display());
     let shift = |m: &PolyMesh, pos: &[Point3], dy: f64| {
         let mut m = m.clone();
         m.positions = pos.iter().map(|p| p + Vector3::new(0.0, dy, 0.0)).collect();
@@ -163,10 +167,8 @@ fn main() -> subdyn::Result<()> {
         title: Some("barbell lattice: rest and twisted + lifted right block (3 levels)".into()),
         ..Default::default()
     };
-    write_png(
-        std::path::Path::new("barbell.png"),
-        &render(&scene, &options)?,
-    )?;
-    println!("wrote barbell.png");
+    let path = out_dir.join("barbell.png");
+    write_png(&path, &render(&scene, &options)?)?;
+    println!("wrote {}", path.display());
     Ok(())
 }

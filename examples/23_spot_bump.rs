@@ -8,10 +8,12 @@
 //! Catmull-Clark refinement), which the embedding handles by tetrahedra.
 //!
 //! Input: a mesh path (default `../shared/data/meshes/spot.obj`; when it is
-//! absent, the Spot mesh built into `subdyn::examples`). Outputs in the
-//! current directory: `spot_bump.obj` and `spot_bump.png` (rest and bumped,
+//! absent, the Spot mesh built into `subdyn::examples`). Outputs in
+//! `target/examples-out/`: `spot_bump.obj` and `spot_bump.png` (rest and bumped,
 //! the lattice's hull as a wireframe). Run with
 //! `cargo run --release --example 23_spot_bump [-- MESH]`.
+
+mod common;
 
 use subdyn::ffd::{Ffd, FfdParams};
 use subdyn::lattice::{BoxLatticeParams, box_lattice, locally_refined};
@@ -21,6 +23,7 @@ use subdyn::render::{MeshLayer, RenderOptions, Scene, render, write_png};
 use subdyn::subdivision::{RefineOptions, Refiner};
 
 fn main() -> subdyn::Result<()> {
+    let out_dir = common::output_dir()?;
     let path = std::env::args()
         .nth(1)
         .unwrap_or_else(|| "../shared/data/meshes/spot.obj".into());
@@ -111,8 +114,9 @@ fn main() -> subdyn::Result<()> {
         "{moved_vertices} of {} vertices moved by more than 0.1 % of the diagonal",
         model.num_vertices()
     );
-    subdyn::io::write_mesh("spot_bump.obj", &out, None)?;
-    println!("wrote spot_bump.obj");
+    let path = out_dir.join("spot_bump.obj");
+    subdyn::io::write_mesh(&path, &out, None)?;
+    println!("wrote {}", path.display());
     let shift = |m: &PolyMesh, pos: &[Point3], dx: f64| {
         let mut m = m.clone();
         m.positions = pos
@@ -147,10 +151,8 @@ fn main() -> subdyn::Result<()> {
         title: Some("Spot: rest and a local bump from one locally refined lattice cell".into()),
         ..Default::default()
     };
-    write_png(
-        std::path::Path::new("spot_bump.png"),
-        &render(&scene, &options)?,
-    )?;
-    println!("wrote spot_bump.png");
+    let path = out_dir.join("spot_bump.png");
+    write_png(&path, &render(&scene, &options)?)?;
+    println!("wrote {}", path.display());
     Ok(())
 }

@@ -5,12 +5,12 @@
 //! closes it.
 //!
 //! Inputs: none (an octagonal control polygon is built in). Output:
-//! `finetune_closed_curve.png` in the current directory (grey: control
+//! `finetune_closed_curve.png` in `target/examples-out/` (grey: control
 //! polygon, blue: original limit curve, red: fine-tuned curve, green: the
 //! exact but unclosed `Q`). Run with
 //! `cargo run --release --example 30_finetune_closed_curve`.
 
-use std::path::Path;
+mod common;
 
 use subdyn::finetune::{
     CurveFinetune, CurveFinetuneParams, alpha_from_values, comparison_layers, curve_layer,
@@ -21,6 +21,7 @@ use subdyn::render::write_png;
 use subdyn::subdivision::{CurveScheme, CurveTopology};
 
 fn main() -> subdyn::Result<()> {
+    let out = common::output_dir()?;
     let polygon: Vec<Point3> = [
         (0., 0.),
         (2., 0.),
@@ -66,7 +67,8 @@ fn main() -> subdyn::Result<()> {
         800,
         640,
     )?;
-    write_png(Path::new("finetune_closed_curve.png"), &picture)?;
-    println!("wrote finetune_closed_curve.png");
+    let path = out.join("finetune_closed_curve.png");
+    write_png(&path, &picture)?;
+    println!("wrote {}", path.display());
     Ok(())
 }

@@ -5,11 +5,11 @@
 //! Then `Q'(t) = α(t) P'(t)` is checked at 1,000 parameters.
 //!
 //! Inputs: none (the wave is built in). Output: `finetune_open_curve.png` in
-//! the current directory (grey: control polygon, blue: original curve, red:
+//! `target/examples-out/` (grey: control polygon, blue: original curve, red:
 //! fine-tuned curve). Run with
 //! `cargo run --release --example 31_finetune_open_curve`.
 
-use std::path::Path;
+mod common;
 
 use subdyn::finetune::{alpha_from_values, comparison_layers, curve_picture, exact_finetune};
 use subdyn::math::Point3;
@@ -17,6 +17,7 @@ use subdyn::render::write_png;
 use subdyn::subdivision::{CurveScheme, CurveTopology};
 
 fn main() -> subdyn::Result<()> {
+    let out = common::output_dir()?;
     let n = 12;
     let polygon: Vec<Point3> = (0..n)
         .map(|i| Point3::new(i as f64, if i % 2 == 0 { 0.0 } else { 1.5 }, 0.0))
@@ -49,7 +50,8 @@ fn main() -> subdyn::Result<()> {
         900,
         500,
     )?;
-    write_png(Path::new("finetune_open_curve.png"), &picture)?;
-    println!("wrote finetune_open_curve.png");
+    let path = out.join("finetune_open_curve.png");
+    write_png(&path, &picture)?;
+    println!("wrote {}", path.display());
     Ok(())
 }

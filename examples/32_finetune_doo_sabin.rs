@@ -4,11 +4,13 @@
 //! (y = 0) vertices 0, 1, 4 are fixed.
 //!
 //! Inputs: none (`subdyn::examples::cube`). Outputs (in the directory given as
-//! the first argument, default `.`): `finetune_surface.png` — left the
+//! the first argument, default `target/examples-out/`): `finetune_surface.png` — left the
 //! converted non-uniform Catmull-Clark surface (ε = 0.05, depth 3) with its
 //! control mesh, right the fine-tuned one coloured by how far the surface
 //! moved (fraction of the cube's side); `finetune_surface.obj` — the
 //! fine-tuned control mesh. Run: `cargo run --release --example 32_finetune_doo_sabin [DIR]`.
+
+mod common;
 
 use std::path::PathBuf;
 
@@ -45,7 +47,10 @@ fn screen_right() -> Vector3 {
 }
 
 fn main() -> subdyn::Result<()> {
-    let dir = PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| ".".into()));
+    let dir = match std::env::args().nth(1) {
+        Some(dir) => PathBuf::from(dir),
+        None => common::output_dir()?,
+    };
     let cube = subdyn::examples::cube();
     let values = [(7, 3, 1.3), (7, 5, 1.3), (7, 6, 1.3)];
     let p = SurfaceFineTune::new(
@@ -100,6 +105,8 @@ fn main() -> subdyn::Result<()> {
     let picture = render(&scene, &options)?;
     write_png(&dir.join("finetune_surface.png"), &picture)?;
     subdyn::io::write_mesh(dir.join("finetune_surface.obj"), &out, None)?;
-    println!("wrote {}", dir.join("finetune_surface.png").display());
+    for name in ["finetune_surface.png", "finetune_surface.obj"] {
+        println!("wrote {}", dir.join(name).display());
+    }
     Ok(())
 }

@@ -4,9 +4,11 @@
 //! pulls the surface towards those edges.
 //!
 //! Inputs: none (`subdyn::examples::cube`). Outputs (in the directory given as
-//! the first argument, default `.`): `non_uniform_cube.png`, the level-4
+//! the first argument, default `target/examples-out/`): `non_uniform_cube.png`, the level-4
 //! surfaces for `d = 1, 0.25, 0.02` from left to right.
 //! Run: `cargo run --release --example 33_non_uniform_cube [DIR]`.
+
+mod common;
 
 use std::path::PathBuf;
 
@@ -17,7 +19,10 @@ use subdyn::subdivision::NonUniformHierarchy;
 use subdyn::topology::Level;
 
 fn main() -> subdyn::Result<()> {
-    let dir = PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| ".".into()));
+    let dir = match std::env::args().nth(1) {
+        Some(dir) => PathBuf::from(dir),
+        None => common::output_dir()?,
+    };
     let cube = subdyn::examples::cube();
     let level = Level::from_mesh(&cube)?;
     // Screen right for the renderer's azimuth of 30° about +Y.

@@ -3,10 +3,12 @@
 //! tool, let go, make the dragged shape plastic, then extrude the top face
 //! and watch the new cell settle.
 //!
-//! Inputs: none. Outputs in the current directory: `sculpt_cube.obj` (the
+//! Inputs: none. Outputs in `target/examples-out/`: `sculpt_cube.obj` (the
 //! level-2 boundary surface at the end) and `sculpt_cube.png` (before,
 //! dragged, after make plastic and extrusion). Prints the energies.
 //! Run with `cargo run --release --example 40_sculpt_cube`.
+
+mod common;
 
 use subdyn::lattice::box_grid;
 use subdyn::math::Point3;
@@ -34,6 +36,7 @@ fn picture(mesh: &PolyMesh, title: &str) -> subdyn::Result<Picture> {
 }
 
 fn main() -> subdyn::Result<()> {
+    let out = common::output_dir()?;
     let cube = box_grid(Point3::origin(), Point3::new(1.0, 1.0, 1.0), [2, 2, 2])?;
     let mut solid = Solid::new(&cube, SolidParams::default())?;
     let bottom: Vec<usize> = (0..27)
@@ -87,12 +90,13 @@ fn main() -> subdyn::Result<()> {
     );
     let end = solid.boundary_mesh()?;
     frames.push(picture(&end, "plastic, extruded")?);
-    subdyn::io::write_mesh("sculpt_cube.obj", &end, None)?;
-
+    subdyn::io::write_mesh(out.join("sculpt_cube.obj"), &end, None)?;
     write_png(
-        std::path::Path::new("sculpt_cube.png"),
+        &out.join("sculpt_cube.png"),
         &Picture::side_by_side(&frames)?,
     )?;
-    println!("wrote sculpt_cube.obj and sculpt_cube.png");
+    for name in ["sculpt_cube.obj", "sculpt_cube.png"] {
+        println!("wrote {}", out.join(name).display());
+    }
     Ok(())
 }

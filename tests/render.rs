@@ -11,8 +11,9 @@ use std::process::{Command, Output};
 use subdyn::math::{Point3, Real};
 use subdyn::mesh::{PointCloud, PolyMesh};
 use subdyn::render::{
-    Camera, CloudLayer, ColorMap, MeshLayer, Picture, Projection, RenderOptions, Rgb, Scene,
-    render, write_png,
+    Camera, CloudLayer, ColorMap, HLine, MeshLayer, Picture, PlotOptions, Projection,
+    RenderOptions, Rgb, Scene, Series, distance_range, line_plot, log_tick_labels, log_ticks,
+    nice_ticks, render, write_png,
 };
 
 const WHITE: Rgb = [255, 255, 255];
@@ -436,6 +437,102 @@ fn write_png_round_trips_and_leaves_nothing_on_failure() {
 }
 
 // ---------------------------------------------------------------------------
+// Ticks, plots and the distance colour range
+
+#[test]
+fn log_ticks_follow_the_one_two_five_rule_with_at_least_three_labels() {
+    assert_eq!(log_ticks((0.003, 2.0), 8), vec![0.01, 0.1, 1.0]);
+    assert_eq!(log_ticks((0.03, 0.6), 8), vec![0.05, 0.1, 0.2, 0.5]);
+    assert_eq!(
+        log_ticks((0.06, 0.4), 8),
+        vec![0.06, 0.07, 0.08, 0.09, 0.1, 0.2, 0.3, 0.4]
+    );
+    // Twelve decades, at most four labels: every fourth power of ten.
+    assert_eq!(log_ticks((1e-6, 1e6), 4), vec![1e-4, 1.0, 1e4]);
+    assert_eq!(
+        log_tick_labels(&log_ticks((0.03, 0.6), 8)),
+        vec!["0.05", "0.1", "0.2", "0.5"]
+    );
+    for range in [
+        (0.011, 0.019),
+        (1.1, 1.3),
+        (0.2, 30.0),
+        (2e-5, 3e-4),
+        (7.0, 7.5),
+    ] {
+        let t = log_ticks(range, 8);
+        assert!(t.len() >= 3, "{range:?}: {t:?}");
+        assert!(t.windows(2).all(|w| w[0] < w[1]), "{range:?}: {t:?}");
+        assert!(
+            t.iter()
+                .all(|&x| x >= range.0 * (1.0 - 1e-9) && x <= range.1 * (1.0 + 1e-9)),
+            "{range:?}: {t:?}"
+        );
+        let labels = log_tick_labels(&t);
+        let distinct: std::collections::HashSet<_> = labels.iter().collect();
+        assert_eq!(distinct.len(), labels.len(), "{labels:?}");
+    }
+    // The time axis of a 3.4 s fit: four labelled ticks, not two.
+    assert_eq!(nice_ticks((0.0, 3.4), 6), vec![0.0, 1.0, 2.0, 3.0]);
+}
+
+#[test]
+fn a_plot_draws_its_tolerance_line_even_below_the_data_and_its_title() {
+    let red = [200, 30, 30];
+    let series = [Series {
+        label: "p95".into(),
+        points: vec![(0.0, 0.5), (1.0, 0.2), (2.0, 0.05)],
+        color: [0, 0, 255],
+    }];
+    let plain = PlotOptions {
+        log_y: true,
+        ..PlotOptions::default()
+    };
+    let with_line = PlotOptions {
+        title: Some("all points".into()),
+        hlines: vec![HLine {
+            y: 0.01,
+            label: "tolerance".into(),
+            color: red,
+        }],
+        ..plain.clone()
+    };
+    let a = line_plot(&series, &plain).unwrap();
+    let b = line_plot(&series, &with_line).unwrap();
+    assert_eq!(a.count(|c| c == red), 0);
+    // Dashes across the plot (about half of ~580 pixels) and the label.
+    assert!(b.count(|c| c == red) > 250, "{}", b.count(|c| c == red));
+    // The title is ink in the top band, which is empty without it.
+    let ink_on_top =
+        |p: &Picture| (0..p.width()).any(|x| (2..14).any(|y| p.get(x, y) != Some(WHITE)));
+    assert!(ink_on_top(&b) && !ink_on_top(&a));
+    let bad = PlotOptions {
+        hlines: vec![HLine {
+            y: 0.0,
+            label: "zero".into(),
+            color: red,
+        }],
+        ..plain
+    };
+    assert!(line_plot(&series, &bad).is_err());
+}
+
+#[test]
+fn the_distance_range_clips_one_hot_spot_at_the_99th_percentile() {
+    let mut d: Vec<Real> = (0..999).map(|i| i as Real / 1000.0).collect();
+    d.push(100.0);
+    // Nearest rank 990 of 1,000: the 990th smallest value, 0.989.
+    assert_eq!(distance_range(&d, 99.0), Some((0.0, 0.989)));
+    assert_eq!(distance_range(&d, 100.0), Some((0.0, 100.0)));
+    // Not-a-number values are left out; all zero but one: the top is the largest.
+    let mut z = vec![0.0; 999];
+    z.extend([3.0, Real::NAN]);
+    assert_eq!(distance_range(&z, 99.0), Some((0.0, 3.0)));
+    assert_eq!(distance_range(&[Real::NAN], 99.0), None);
+    assert_eq!(distance_range(&[], 99.0), None);
+}
+
+// ---------------------------------------------------------------------------
 // The command line
 
 /// Runs `subdyn` with `args` in `dir`.
@@ -544,6 +641,49 @@ fn cli_draws_limit_surfaces_cages_points_and_distances() {
         let c = ColorMap::Viridis.color(end);
         assert!(png.pixels().any(|p| p.0 == c), "no legend colour for {end}");
     }
+}
+
+#[test]
+fn cli_clips_distance_colours_at_the_99th_percentile_unless_a_range_is_given() {
+    let dir = cube_dir();
+    let d = dir.path();
+    // 300 points just above the cube's top face (0 to 0.3 % of its
+    // diagonal away) and one hot spot 4 units above it.
+    let mut xyz: String = (0..300)
+        .map(|i| {
+            let (x, y) = ((i % 20) as Real / 20.0, (i / 20) as Real / 15.0);
+            format!("{x} {y} {}\n", 1.0 + 1e-5 * i as Real)
+        })
+        .collect();
+    xyz.push_str("0.5 0.5 5\n");
+    std::fs::write(d.join("pts.xyz"), xyz).unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "pts.xyz",
+            "-o",
+            "p.png",
+            "--color-by-distance-to",
+            "cube.obj",
+        ];
+        args.extend(extra);
+        let out = subdyn(d, &args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let clipped = run(&[]);
+    // The hot spot: 4 / √3 = 230.94 % of the diagonal.
+    assert!(
+        clipped.contains("the 99th percentile of the distances;")
+            && clipped.contains("up to 230.94"),
+        "{clipped}"
+    );
+    let full = run(&["--range", "0,250"]);
+    assert!(!full.contains("99th percentile"), "{full}");
 }
 
 #[test]

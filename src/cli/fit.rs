@@ -8,7 +8,9 @@ use clap::{Args, ValueEnum};
 use serde_json::json;
 
 use subdyn::fit::init::InitParams;
-use subdyn::fit::{FitParams, FitReport, FitStart, Refinement, ToleranceStat, fit_from_start};
+use subdyn::fit::{
+    FitParams, FitReport, FitStart, Refinement, ToleranceStat, fit_from_start, stat_name,
+};
 use subdyn::io::{read_points, write_mesh};
 use subdyn::limit::limit_surface_mesh;
 use subdyn::subdivision::{RefineOptions, Refiner};
@@ -125,8 +127,10 @@ pub struct FitArgs {
     /// Write a JSON report (per level: control points, time, CG iterations, errors).
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
-    /// Write a PNG plot of the error (95th percentile and RMS, % of the
-    /// diagonal) against time, one colour per level.
+    /// Write a PNG plot of the error (% of the diagonal, log scale) against
+    /// time: per step the 95th percentile and RMS of the inliers the springs
+    /// used, one colour per level; in black the table's 95th percentile over
+    /// all points at the end of each level; the tolerance as a dashed line.
     #[arg(long, value_name = "P.png")]
     pub plot: Option<PathBuf>,
     /// No progress display and no warnings.
@@ -189,8 +193,16 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     };
     progress.stage("building the initial model");
     let start_mesh = fit_start(&args.init, args.init_resolution, args.quiet)?;
+    let levels = params.max_level as u64 + 1;
     let mut fit_progress = |level: usize, step: usize, energy: f64| {
-        progress.stage(format!("level {level}, step {step}: energy {energy:.4e}"));
+        progress.counted(
+            level as u64,
+            levels,
+            format!(
+                "levels (at most) · level {level}, step {step} (≤ {}): energy {energy:.4e}",
+                params.max_steps
+            ),
+        );
     };
     let mut run = fit_from_start(&cloud, &start_mesh, &params, &mut fit_progress)
         .map_err(|e| anyhow::Error::new(e).context(format!("fitting {name}")))?;
@@ -214,7 +226,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         written.add(path, "limit surface");
     }
     if let Some(path) = &args.plot {
-        write_plot(path, &result.report)?;
+        write_plot(path, &result.report, &params)?;
         written.add(path, "convergence plot");
     }
     drop(progress);
@@ -238,10 +250,13 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     written.print_after(&summary(&name, &result.report))
 }
 
-/// Error against time, one colour per level (p95 solid markers, RMS as a
-/// second series per level).
-fn write_plot(path: &Path, report: &FitReport) -> anyhow::Result<()> {
-    use subdyn::render::{Series, line_plot, series_color, write_png};
+/// Error against time, one colour per level: per step the 95th percentile
+/// and RMS of the points the springs used (inliers, subsampled on coarse
+/// levels), and in black the table's 95th percentile over all points at the
+/// end of each level; the tolerance as a dashed line. The title says which
+/// set each is.
+fn write_plot(path: &Path, report: &FitReport, params: &FitParams) -> anyhow::Result<()> {
+    use subdyn::render::{HLine, PlotOptions, Series, line_plot, series_color, write_png};
     let n = report.levels.len();
     let mut series = Vec::new();
     for (i, l) in report.levels.iter().enumerate() {
@@ -265,14 +280,38 @@ fn write_plot(path: &Path, report: &FitReport) -> anyhow::Result<()> {
             color: light,
         });
     }
-    let pic = line_plot(
-        &series,
-        "seconds",
-        "distance, % of diagonal",
-        true,
-        800,
-        480,
-    )?;
+    series.push(Series {
+        label: "p95, all points".into(),
+        points: report
+            .levels
+            .iter()
+            .map(|l| (l.elapsed, l.error.p95_pct.max(1e-9)))
+            .collect(),
+        color: [0, 0, 0],
+    });
+    let title = format!(
+        "fit error: colours = the inliers the springs used ({} outliers left out); black = all {} points, as in the table",
+        thousands(report.outliers),
+        thousands(report.points)
+    );
+    let options = PlotOptions {
+        title: Some(title),
+        x_label: "seconds".into(),
+        y_label: "distance, % of diagonal (log)".into(),
+        log_y: true,
+        hlines: vec![HLine {
+            y: params.tolerance_pct,
+            label: format!(
+                "tolerance {} % ({})",
+                params.tolerance_pct,
+                stat_name(params.tolerance_stat)
+            ),
+            color: [200, 30, 30],
+        }],
+        width: 960,
+        height: 540,
+    };
+    let pic = line_plot(&series, &options)?;
     write_png(path, &pic).map_err(|e| about_file(e, path))
 }
 

@@ -274,8 +274,13 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
         report: init_json,
     } = init?;
     let init_s = seconds(t);
+    let levels = params.max_level as u64 + 1;
     let mut on_step = |level: usize, step: usize, energy: f64| {
-        progress.stage(format!("level {level}, step {step}: energy {energy:.4e}"));
+        progress.counted(
+            level as u64,
+            levels,
+            format!("levels (at most) · level {level}, step {step}: energy {energy:.4e}"),
+        );
     };
     let (result, evolution_peak) =
         stage_peak(|| recover_shape(&prepared, &init, &points, &boundary, &params, &mut on_step));

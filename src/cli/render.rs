@@ -13,8 +13,8 @@ use subdyn::math::{Real, bbox_diagonal};
 use subdyn::mesh::{PointCloud, PolyMesh};
 use subdyn::metrics::{TriangleBvh, distances};
 use subdyn::render::{
-    CloudLayer, EDGES, Label, MAX_SIDE, MeshLayer, Projection, RenderOptions, Scene,
-    check_png_path, render, write_png,
+    CloudLayer, DISTANCE_PERCENTILE, EDGES, Label, MAX_SIDE, MeshLayer, Projection, RenderOptions,
+    Scene, check_png_path, distance_range, render, write_png,
 };
 
 use super::common::{Written, about_file, thousands};
@@ -33,7 +33,8 @@ const MAX_LIMIT_FACES: f64 = 20_000_000.0;
 #[command(
     after_help = "The view orbits the centre of the bounding box: azimuth 0, elevation 0 \
     looks from +Z with +Y up; azimuth 90 looks from +X. Front faces are blue-grey, back faces \
-    orange. With --color-by-distance-to, the legend is in % of REF's bounding-box diagonal."
+    orange. With --color-by-distance-to, the legend is in % of REF's bounding-box diagonal, \
+    clipped at the 99th percentile unless --range is given."
 )]
 pub struct RenderArgs {
     /// Mesh or point file (.obj, .ply, .off, .xyz); a file without faces is
@@ -48,7 +49,10 @@ pub struct RenderArgs {
     #[arg(long, value_name = "CLOUD")]
     pub points: Option<PathBuf>,
     /// Colour IN's vertices (or points) by their distance to the surface of
-    /// REF, in % of REF's bounding-box diagonal, with a legend.
+    /// REF, in % of REF's bounding-box diagonal, with a legend; the colours
+    /// span 0 to the 99th percentile of the distances (the legend then
+    /// reads "dist % p99", larger ones take the top colour) unless --range
+    /// is given.
     #[arg(long, value_name = "REF")]
     pub color_by_distance_to: Option<PathBuf>,
     /// View direction in degrees: azimuth about +Y, elevation above the XZ plane (−90 to 90).
@@ -89,7 +93,8 @@ pub struct RenderArgs {
     /// A title line at the top of the picture.
     #[arg(long, value_name = "TEXT")]
     pub title: Option<String>,
-    /// Values at the two ends of the colour map (default: smallest and largest).
+    /// Values at the two ends of the colour map (default: smallest and
+    /// largest; with --color-by-distance-to, 0 and the 99th percentile).
     #[arg(long, value_name = "MIN,MAX", allow_hyphen_values = true)]
     pub range: Option<String>,
     #[command(flatten)]
@@ -169,16 +174,27 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     };
 
     let mut options = options;
+    // Without --range, 0 to the 99th percentile: a hot spot takes the top
+    // colour instead of squeezing everything else into the bottom one.
+    let mut clip_note = String::new();
     if let Some(d) = &distance
         && options.scalar_range.is_none()
+        && let Some((lo, hi)) = distance_range(d, DISTANCE_PERCENTILE)
     {
-        // Anchored at 0: the colour says how far, not how far beyond the nearest vertex.
+        options.scalar_range = Some((lo, hi));
         let max = d
             .iter()
             .copied()
             .filter(|x| x.is_finite())
             .fold(0.0, Real::max);
-        options.scalar_range = Some((0.0, max));
+        if max > hi {
+            let above = d.iter().filter(|&&x| x > hi).count();
+            options.legend_label = Some("dist % p99".into());
+            clip_note = format!(
+                "colours 0 to {hi:.4} %, the 99th percentile of the distances; {} above it in the top colour, up to {max:.4} % (--range 0,{max:.4} shows all)\n",
+                thousands(above)
+            );
+        }
     }
     let mut scene = Scene::default();
     if let Some(m) = surface {
@@ -216,7 +232,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         format!("picture, {}×{}", picture.width(), picture.height()),
     );
     written.print_after(&format!(
-        "rendered {name} ({})\n",
+        "rendered {name} ({})\n{clip_note}",
         describe(surface, cloud.as_ref(), extra.as_ref()),
     ))
 }

@@ -250,8 +250,8 @@ fn session(
                 "max_cg_iterations": it,
             }));
             since_frame = (0.0, 0, 0);
-            progress.stage(format!("step {step} of {}", script.steps));
         }
+        progress.counted(step as u64, script.steps as u64, "steps");
         if snapshot_steps.contains(&step) {
             snapshots.push(snapshot(solid, step)?);
         }

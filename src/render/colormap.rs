@@ -51,6 +51,35 @@ impl ColorMap {
     }
 }
 
+/// The default colour range of distances: from 0 (the colour says how far,
+/// not how far beyond the nearest point) to the `p`-th percentile of the
+/// finite values ([`crate::metrics::percentile`], nearest rank), so that a
+/// few hot spots above it (drawn in the top colour) do not turn the rest
+/// of the picture into one colour; `subdyn render` uses `p = 99`
+/// ([`DISTANCE_PERCENTILE`]). `None` when no value is finite; the top is
+/// raised to the largest value when the percentile is 0.
+///
+/// ```
+/// use subdyn::render::distance_range;
+/// let mut d = vec![0.1; 999];
+/// d.push(50.0); // one hot spot
+/// assert_eq!(distance_range(&d, 99.0), Some((0.0, 0.1)));
+/// assert_eq!(distance_range(&d, 100.0), Some((0.0, 50.0)));
+/// ```
+pub fn distance_range(values: &[Real], p: Real) -> Option<(Real, Real)> {
+    let finite: Vec<Real> = values.iter().copied().filter(|v| v.is_finite()).collect();
+    let top = crate::metrics::percentile(&finite, p)?;
+    let top = if top > 0.0 {
+        top
+    } else {
+        finite.iter().copied().fold(0.0, Real::max)
+    };
+    Some((0.0, top))
+}
+
+/// The percentile [`distance_range`] clips at in `subdyn render`.
+pub const DISTANCE_PERCENTILE: Real = 99.0;
+
 /// Maps a scalar to `[0, 1]` over `range` (not clamped); with a degenerate
 /// range, values up to `lo` map to 0 and larger ones to 1.
 pub(crate) fn normalise(value: Real, range: (Real, Real)) -> Real {

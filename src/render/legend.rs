@@ -59,6 +59,75 @@ pub fn nice_ticks(range: (Real, Real), target: usize) -> Vec<Real> {
     vec![lo, hi]
 }
 
+/// Tick values for a logarithmic axis over `range` (both ends above 0): the
+/// powers of ten inside it; when those are fewer than three, also 2 and 5 ×
+/// 10ᵏ; when still fewer, every m × 10ᵏ (m = 1 … 9); when still fewer (a
+/// range narrower than about a factor 1.5), the linear [`nice_ticks`]. Of
+/// more than `max` powers of ten every second (third, …) is kept.
+///
+/// ```
+/// use subdyn::render::log_ticks;
+/// assert_eq!(log_ticks((0.003, 2.0), 8), vec![0.01, 0.1, 1.0]);
+/// assert_eq!(log_ticks((0.03, 0.6), 8), vec![0.05, 0.1, 0.2, 0.5]);
+/// assert_eq!(log_ticks((1e-6, 1e6), 4), vec![1e-4, 1.0, 1e4]);
+/// ```
+pub fn log_ticks(range: (Real, Real), max: usize) -> Vec<Real> {
+    let (lo, hi) = range;
+    if !(lo > 0.0 && hi.is_finite() && hi > lo) {
+        return nice_ticks(range, max.max(2));
+    }
+    let (e0, e1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let inside = |v: &Real| *v >= lo * (1.0 - 1e-9) && *v <= hi * (1.0 + 1e-9);
+    let value = |m: i32, e: i32| {
+        if e >= 0 {
+            m as Real * ten(e)
+        } else {
+            m as Real / ten(-e)
+        }
+    };
+    let decades: Vec<i32> = (e0..=e1).filter(|&e| inside(&value(1, e))).collect();
+    if decades.len() >= 3 {
+        // Every k-th power of ten, anchored at 10⁰ when it is inside.
+        let k = decades.len().div_ceil(max.max(2)).max(1) as i32;
+        return decades
+            .into_iter()
+            .filter(|e| e.rem_euclid(k) == 0)
+            .map(|e| value(1, e))
+            .collect();
+    }
+    for mantissas in [&[1, 2, 5][..], &[1, 2, 3, 4, 5, 6, 7, 8, 9]] {
+        let t: Vec<Real> = (e0..=e1)
+            .flat_map(|e| mantissas.iter().map(move |&m| value(m, e)))
+            .filter(inside)
+            .collect();
+        if t.len() >= 3 {
+            return t;
+        }
+    }
+    nice_ticks(range, 4)
+}
+
+/// Labels for [`log_ticks`]: each value in its shortest form (`0.05`, `1`,
+/// `20`), in scientific notation below 10⁻³ or from 10⁵ on (`1e-6`).
+///
+/// ```
+/// use subdyn::render::log_tick_labels;
+/// assert_eq!(log_tick_labels(&[0.05, 0.1, 1.0, 20.0]), vec!["0.05", "0.1", "1", "20"]);
+/// assert_eq!(log_tick_labels(&[1e-6, 1e6]), vec!["1e-6", "1e6"]);
+/// ```
+pub fn log_tick_labels(ticks: &[Real]) -> Vec<String> {
+    ticks
+        .iter()
+        .map(|&t| {
+            if t != 0.0 && !(1e-3..1e5).contains(&t.abs()) {
+                format!("{t:e}")
+            } else {
+                format!("{t}")
+            }
+        })
+        .collect()
+}
+
 /// 10^e.
 fn ten(e: i32) -> Real {
     10f64.powi(e)

@@ -40,12 +40,12 @@ mod slices;
 mod viridis;
 
 pub use camera::{Camera, Projection, ScreenPoint};
-pub use colormap::{ColorMap, NO_VALUE};
+pub use colormap::{ColorMap, DISTANCE_PERCENTILE, NO_VALUE, distance_range};
 pub use draw::render;
 pub use font::{draw_text, text_width};
-pub use legend::{nice_ticks, tick_labels};
+pub use legend::{log_tick_labels, log_ticks, nice_ticks, tick_labels};
 pub use picture::{MAX_SIDE, Picture, Rgb, check_png_path, write_png};
-pub use plot::{Series, line_plot, series_color};
+pub use plot::{HLine, PlotOptions, Series, line_plot, series_color};
 pub use scene::{
     BACK, CloudLayer, EDGES, LABELS, Label, MAX_WORK_PIXELS, MeshLayer, POINTS, RenderOptions,
     SURFACE, Scene,

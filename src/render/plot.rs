@@ -4,7 +4,11 @@
 use crate::error::{Error, Result};
 use crate::math::Real;
 
-use super::{ColorMap, Picture, Rgb, draw_text, nice_ticks, text_width, tick_labels};
+use super::legend::{draw_title, title_height};
+use super::{
+    ColorMap, Picture, Rgb, draw_text, log_tick_labels, log_ticks, nice_ticks, text_width,
+    tick_labels,
+};
 
 /// One curve: a label, its points `(x, y)` and its colour.
 #[derive(Clone, Debug)]
@@ -17,16 +21,56 @@ pub struct Series {
     pub color: Rgb,
 }
 
-/// A plot of `series` with a logarithmic y axis when `log_y` (all `y > 0`
-/// then required), axis labels and a key; `width × height` pixels.
-pub fn line_plot(
-    series: &[Series],
-    x_label: &str,
-    y_label: &str,
-    log_y: bool,
-    width: u32,
-    height: u32,
-) -> Result<Picture> {
+/// A horizontal reference line across the plot (a tolerance), dashed, with
+/// its label above its right end.
+#[derive(Clone, Debug)]
+pub struct HLine {
+    /// Height on the y axis (above 0 on a log axis).
+    pub y: Real,
+    /// Drawn above the line.
+    pub label: String,
+    /// Line and label colour.
+    pub color: Rgb,
+}
+
+/// How [`line_plot`] draws. Every field has a default (see [`Default`]).
+#[derive(Clone, Debug)]
+pub struct PlotOptions {
+    /// A line of text centred at the top, e.g. what was measured (default none).
+    pub title: Option<String>,
+    /// Below the x axis (default empty).
+    pub x_label: String,
+    /// Above the y axis (default empty).
+    pub y_label: String,
+    /// Logarithmic y axis; all `y` must then be above 0 (default false).
+    pub log_y: bool,
+    /// Horizontal reference lines, kept inside the y range (default none).
+    pub hlines: Vec<HLine>,
+    /// Picture width in pixels (default 800).
+    pub width: u32,
+    /// Picture height in pixels (default 480).
+    pub height: u32,
+}
+
+impl Default for PlotOptions {
+    fn default() -> Self {
+        PlotOptions {
+            title: None,
+            x_label: String::new(),
+            y_label: String::new(),
+            log_y: false,
+            hlines: Vec::new(),
+            width: 800,
+            height: 480,
+        }
+    }
+}
+
+/// A plot of `series` with labelled ticks on both axes (a "nice" rule:
+/// [`nice_ticks`] on a linear axis, [`log_ticks`] on a logarithmic one),
+/// axis labels, the `options.hlines` and a key.
+pub fn line_plot(series: &[Series], options: &PlotOptions) -> Result<Picture> {
+    let (width, height, log_y) = (options.width, options.height, options.log_y);
     let pts: Vec<(Real, Real)> = series
         .iter()
         .flat_map(|s| s.points.iter().copied())
@@ -34,10 +78,8 @@ pub fn line_plot(
     if pts.is_empty() {
         return Err(Error::Input("nothing to plot".into()));
     }
-    if pts
-        .iter()
-        .any(|p| !p.0.is_finite() || !p.1.is_finite() || (log_y && p.1 <= 0.0))
-    {
+    let bad = |x: Real, y: Real| !x.is_finite() || !y.is_finite() || (log_y && y <= 0.0);
+    if pts.iter().any(|p| bad(p.0, p.1)) || options.hlines.iter().any(|h| bad(0.0, h.y)) {
         return Err(Error::Input(
             "plot values must be finite (and positive on a log axis)".into(),
         ));
@@ -51,6 +93,10 @@ pub fn line_plot(
         y0 = y0.min(fy(y));
         y1 = y1.max(fy(y));
     }
+    for h in &options.hlines {
+        y0 = y0.min(fy(h.y));
+        y1 = y1.max(fy(h.y));
+    }
     if x1 - x0 < 1e-12 {
         x1 = x0 + 1.0;
     }
@@ -60,14 +106,20 @@ pub fn line_plot(
     }
     let (x0, y0, y1) = (x0.min(0.0), y0 - 0.05 * (y1 - y0), y1 + 0.05 * (y1 - y0));
     let mut pic = Picture::new(width, height, [255, 255, 255])?;
-    let (left, right, top, bottom) = (70i64, width as i64 - 150, 20i64, height as i64 - 45);
+    let top = match &options.title {
+        Some(_) => title_height(1) as i64 + 16,
+        None => 20,
+    };
+    let (left, right, bottom) = (70i64, width as i64 - 150, height as i64 - 45);
     if right - left < 50 || bottom - top < 50 {
         return Err(Error::Input(format!(
             "plot size {width}×{height} is too small"
         )));
     }
     let sx = |x: Real| left + ((x - x0) / (x1 - x0) * (right - left) as Real).round() as i64;
-    let sy = |y: Real| bottom - ((fy(y) - y0) / (y1 - y0) * (bottom - top) as Real).round() as i64;
+    // `t` on the axis' own scale (log10 y on a log axis).
+    let sy_axis = |t: Real| bottom - ((t - y0) / (y1 - y0) * (bottom - top) as Real).round() as i64;
+    let sy = |y: Real| sy_axis(fy(y));
     let grey = [200, 200, 200];
     let black = [0, 0, 0];
     // Ticks and grid.
@@ -84,20 +136,17 @@ pub fn line_plot(
             black,
         );
     }
-    let yt: Vec<Real> = if log_y {
-        (y0.ceil() as i64..=y1.floor() as i64)
-            .map(|e| e as Real)
-            .collect()
+    let (yt, ylabels) = if log_y {
+        let t = log_ticks((10f64.powf(y0), 10f64.powf(y1)), 8);
+        let labels = log_tick_labels(&t);
+        (t, labels)
     } else {
-        nice_ticks((y0, y1), 6)
-    };
-    let ylabels: Vec<String> = if log_y {
-        yt.iter().map(|e| format!("1e{e}")).collect()
-    } else {
-        tick_labels(&yt)
+        let t = nice_ticks((y0, y1), 6);
+        let labels = tick_labels(&t);
+        (t, labels)
     };
     for (t, label) in yt.iter().zip(ylabels) {
-        let y = bottom - ((t - y0) / (y1 - y0) * (bottom - top) as Real).round() as i64;
+        let y = sy(*t);
         line(&mut pic, (left, y), (right, y), grey);
         draw_text(
             &mut pic,
@@ -112,13 +161,31 @@ pub fn line_plot(
     line(&mut pic, (left, top), (left, bottom), black);
     draw_text(
         &mut pic,
-        (left + right) / 2 - text_width(x_label, 1) as i64 / 2,
+        (left + right) / 2 - text_width(&options.x_label, 1) as i64 / 2,
         bottom + 22,
-        x_label,
+        &options.x_label,
         1,
         black,
     );
-    draw_text(&mut pic, 4, 4, y_label, 1, black);
+    draw_text(&mut pic, 4, top - 14, &options.y_label, 1, black);
+    if let Some(title) = &options.title {
+        draw_title(&mut pic, title, 1);
+    }
+    // Reference lines, dashed, under the curves.
+    for h in &options.hlines {
+        let y = sy(h.y);
+        for x in (left..right).step_by(8) {
+            line(&mut pic, (x, y), ((x + 4).min(right), y), h.color);
+        }
+        draw_text(
+            &mut pic,
+            right - text_width(&h.label, 1) as i64 - 2,
+            y - 10,
+            &h.label,
+            1,
+            h.color,
+        );
+    }
     // Curves and key.
     for (k, s) in series.iter().enumerate() {
         for w in s.points.windows(2) {
