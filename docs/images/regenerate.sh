@@ -112,6 +112,12 @@ if wanted ffd_spot_bump.png; then
     done_picture ffd_spot_bump.png
 fi
 
+if wanted finetune_closed_curve.png; then
+    "$target/release/examples/30_finetune_closed_curve"
+    cp "$examples_out/finetune_closed_curve.png" $images/finetune_closed_curve.png
+    done_picture finetune_closed_curve.png
+fi
+
 if wanted fit_bun045.png && needs_shared fit_bun045.png; then
     subdyn fit "$shared/scans/bun045.ply" --init auto -o "$tmp/bun_fit.obj" \
         --report "$tmp/bun_rep.json" --plot "$tmp/bun_plot.png" --quiet
@@ -153,7 +159,7 @@ if wanted fit_genus2_outlier_spike.png; then
     subdyn fit "$tmp/g2.ply" -o "$tmp/g2_fit.obj" --limit-out "$tmp/g2_lim.ply" --quiet
     subdyn render "$tmp/g2_lim.ply" --color-by-distance-to "$tmp/g2.truth.obj" \
         -o $images/fit_genus2_outlier_spike.png --view 30,40 --range 0,2 \
-        --title "genus2 + 5% outliers: subdyn fit, distance to truth % diag, view 30,40" --quiet
+        --title "genus2 + 5% outliers: distance to truth, % diag" --quiet
     done_picture fit_genus2_outlier_spike.png
 fi
 
