@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::sdf::{sdf_volume, surface_error, write_raw};
+use common::sdf::{recover_quietly, sdf_volume, surface_error, write_raw};
 
 use subdyn::fit::Refinement;
 use subdyn::fit::recover::{
@@ -26,7 +26,7 @@ fn a_seed_grows_to_a_sphere_iso_surface() {
     };
     let prepared = prepare_volume(&vol, &params).unwrap();
     let init = seed_cage(c + subdyn::math::Vector3::new(2.0, -1.0, 1.0), 3.0).unwrap();
-    let out = recover_shape(&prepared, &init, &[], &[], &params, &mut |_, _, _| {}).unwrap();
+    let out = recover_quietly(&prepared, &init, &[], &params);
     for l in &out.report.levels {
         println!(
             "level {} cps {} samples {} steps {} p95 {:.3} vox unresolved {:.3} {:.2}s",
@@ -65,15 +65,7 @@ fn a_torus_is_recovered_from_its_thresholded_component_with_edges() {
     )
     .unwrap();
     assert_eq!(cage.genus, 1);
-    let out = recover_shape(
-        &prepared,
-        &cage.mesh,
-        &[],
-        &cage.boundary,
-        &params,
-        &mut |_, _, _| {},
-    )
-    .unwrap();
+    let out = recover_quietly(&prepared, &cage.mesh, &cage.boundary, &params);
     for l in &out.report.levels {
         println!(
             "level {} cps {} samples {} steps {} p95 {:.3} vox unresolved {:.3} {:.2}s",
@@ -114,15 +106,7 @@ fn a_rod_two_voxels_thick_is_kept_by_the_automatic_cage() {
         let cage =
             component_cage(&prepared.smoothed, &prepared.smoothed, 0.5, true, None, 12).unwrap();
         assert!(cage.block >= 3, "block {}", cage.block);
-        let out = recover_shape(
-            &prepared,
-            &cage.mesh,
-            &[],
-            &cage.boundary,
-            &params,
-            &mut |_, _, _| {},
-        )
-        .unwrap();
+        let out = recover_quietly(&prepared, &cage.mesh, &cage.boundary, &params);
         let refiner = Refiner::new(&out.control, &RefineOptions::default()).unwrap();
         let (tess, _) = tessellate(&refiner, &out.control.positions, 4).unwrap();
         let reach = tess
@@ -172,8 +156,7 @@ fn a_part_missing_from_the_cage_grows_back_by_the_two_sided_forces() {
             .boundary;
         // The ball's cage: the rod is not in it.
         let ball = seed_cage(c, 9.0).unwrap();
-        let out =
-            recover_shape(&prepared, &ball, &[], &boundary, &params, &mut |_, _, _| {}).unwrap();
+        let out = recover_quietly(&prepared, &ball, &boundary, &params);
         let refiner = Refiner::new(&out.control, &RefineOptions::default()).unwrap();
         let (tess, _) = tessellate(&refiner, &out.control.positions, 4).unwrap();
         let reach = tess
@@ -225,15 +208,7 @@ fn adaptive_levels_keep_within_the_control_point_budget() {
         let cage =
             component_cage(&prepared.smoothed, &prepared.smoothed, 0.5, true, None, 6).unwrap();
         let boundary = cage.boundary;
-        let out = recover_shape(
-            &prepared,
-            &cage.mesh,
-            &[],
-            &boundary,
-            &params,
-            &mut |_, _, _| {},
-        )
-        .unwrap();
+        let out = recover_quietly(&prepared, &cage.mesh, &boundary, &params);
         println!(
             "share {share}: {} control points of {} iso points; {}",
             out.control.num_vertices(),
@@ -530,15 +505,7 @@ fn every_part_of_the_object_is_recovered_unless_a_seed_picks_one() {
     let prepared = prepare_volume(&vol, &params).unwrap();
     let cage = component_cage(&prepared.smoothed, &prepared.smoothed, 0.5, true, None, 12).unwrap();
     assert_eq!((cage.components, cage.parts), (3, 2));
-    let out = recover_shape(
-        &prepared,
-        &cage.mesh,
-        &[],
-        &cage.boundary,
-        &params,
-        &mut |_, _, _| {},
-    )
-    .unwrap();
+    let out = recover_quietly(&prepared, &cage.mesh, &cage.boundary, &params);
     assert!(subdyn::fit::recover::poor_result(&out.report, &params).is_empty());
     let topo = subdyn::fit::init::surface_topology(&out.control).unwrap();
     assert_eq!((topo.components, topo.boundary_loops), (2, 0));
@@ -605,8 +572,7 @@ fn a_part_only_the_forces_volume_holds_still_pulls_the_surface_out() {
     // From the ball's coarse cage, with each set of points.
     let reach_from = |boundary: &[Point3]| {
         let start = seed_cage(c, 9.0).unwrap();
-        let out =
-            recover_shape(&forces, &start, &[], boundary, &params, &mut |_, _, _| {}).unwrap();
+        let out = recover_quietly(&forces, &start, boundary, &params);
         let refiner = Refiner::new(&out.control, &RefineOptions::default()).unwrap();
         let (tess, _) = tessellate(&refiner, &out.control.positions, 4).unwrap();
         let poor = subdyn::fit::recover::poor_result(&out.report, &params);

@@ -4,11 +4,11 @@
 
 mod common;
 
-use common::sdf::{noisy_ball_with_rod, sdf_volume, surface_error, write_raw};
+use common::sdf::{noisy_ball_with_rod, recover_quietly, sdf_volume, surface_error, write_raw};
 use subdyn::fit::ErrorStats;
 use subdyn::fit::recover::{
     RecoverLevel, RecoverParams, RecoverReport, component_cage, poor_result, prepare_volume,
-    recover_shape, seed_cage,
+    seed_cage,
 };
 use subdyn::forces::BoundaryModel;
 use subdyn::limit::tessellate;
@@ -29,15 +29,7 @@ fn a_ball_cut_by_the_box_closes_on_the_box_face() {
     let prepared = prepare_volume(&vol, &params).unwrap();
     assert_eq!(prepared.smoothed.dims(), [34, 34, 34]);
     let cage = component_cage(&prepared.smoothed, &prepared.smoothed, 0.5, true, None, 12).unwrap();
-    let out = recover_shape(
-        &prepared,
-        &cage.mesh,
-        &[],
-        &cage.boundary,
-        &params,
-        &mut |_, _, _| {},
-    )
-    .unwrap();
+    let out = recover_quietly(&prepared, &cage.mesh, &cage.boundary, &params);
     assert!(poor_result(&out.report, &params).is_empty());
     let refiner = Refiner::new(&out.control, &RefineOptions::default()).unwrap();
     assert!((0..refiner.level.num_edges()).all(|e| !refiner.level.is_boundary_edge(e)));

@@ -2,6 +2,7 @@
 //! sampled as a ramp whose 0.5 level is the surface, written as raw f32
 //! with its JSON header, and the distance of a recovered limit surface to it.
 
+use subdyn::fit::recover::{PreparedVolume, RecoverParams, RecoverResult, recover_shape};
 use subdyn::limit::tessellate;
 use subdyn::math::{Point3, Real};
 use subdyn::mesh::PolyMesh;
@@ -62,4 +63,15 @@ pub fn noisy_ball_with_rod(p: Point3) -> Real {
     let rod = (p - (from + t * (tip - from))).norm() - 1.0;
     let noise = 0.05 * ((p.x * 12.9898 + p.y * 78.233 + p.z * 37.719).sin() * 43_758.545).fract();
     ((p - c).norm() - 9.0).min(rod) + noise
+}
+
+/// [`recover_shape`] from the cage `init` with its iso-surface points
+/// `boundary`, no extra points and no progress.
+pub fn recover_quietly(
+    prepared: &PreparedVolume,
+    init: &PolyMesh,
+    boundary: &[Point3],
+    params: &RecoverParams,
+) -> RecoverResult {
+    recover_shape(prepared, init, &[], boundary, params, &mut |_, _, _| {}).unwrap()
 }
