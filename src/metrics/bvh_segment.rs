@@ -124,7 +124,7 @@ impl TriangleBvh {
                     // Each edge from its lower vertex index, as every
                     // triangle sharing it sees it.
                     let edges: [Option<(Point3, Vector3)>; 3] = std::array::from_fn(|e| {
-                        let (a, b) = (ts[e].min(ts[(e + 1) % 3]), ts[e].max(ts[(e + 1) % 3]));
+                        let [a, b] = edge_from_lower(&ts, e);
                         segment(self.positions()[a as usize], self.positions()[b as usize])
                     });
                     let (slo, shi) = exact_box(&self.leaf_corners[slot]);
@@ -206,9 +206,9 @@ impl TriangleBvh {
                 .into_iter()
                 .map(|[a, b]| pair(ids[a as usize], ids[b as usize])),
         );
-        // An edge from its lower vertex index, as the full search takes it.
+        // Edges as the full search takes them.
         let edge = |t: &[u32; 3], e: usize| {
-            let (a, b) = (t[e].min(t[(e + 1) % 3]), t[e].max(t[(e + 1) % 3]));
+            let [a, b] = edge_from_lower(t, e);
             (positions[a as usize], positions[b as usize])
         };
         let shares = |s: &[u32; 3], t: &[u32; 3]| s.iter().any(|v| t.contains(v));
@@ -302,6 +302,13 @@ impl TriangleBvh {
             }
         }
     }
+}
+
+/// Edge `e` of triangle `t` from its lower vertex index: every triangle
+/// sharing the edge tests the same segment.
+fn edge_from_lower(t: &[u32; 3], e: usize) -> [u32; 2] {
+    let (a, b) = (t[e], t[(e + 1) % 3]);
+    [a.min(b), a.max(b)]
 }
 
 /// The segment `a`–`b` as origin and direction, `None` when it has no
