@@ -178,26 +178,34 @@ fn progressive_interpolation_puts_limit_points_on_targets() {
     let all = vec![true; mesh.num_vertices()];
     let mut last = Real::INFINITY;
     for k in [0, 5, 20, 80] {
-        let (_, r) = interpolate_limit_points(&mesh, &targets, &all, k).unwrap();
+        let (_, r) =
+            interpolate_limit_points(&mesh, &RefineOptions::default(), &targets, &all, k).unwrap();
         assert!(r < last, "{k} iterations: residual {r} not below {last}");
         last = r;
     }
     assert!(last < 1e-6, "residual after 80 iterations {last}");
     // The mesh whose limit points these are is a fixed point.
-    let (p, r) = interpolate_limit_points(&other, &targets, &all, 3).unwrap();
+    let (p, r) =
+        interpolate_limit_points(&other, &RefineOptions::default(), &targets, &all, 3).unwrap();
     assert!(r < 1e-12);
     for (a, b) in p.iter().zip(&other.positions) {
         assert!((a - b).norm() < 1e-12);
     }
     // Fixed vertices stay; the movable ones still converge.
     let movable: Vec<bool> = (0..mesh.num_vertices()).map(|v| v % 3 != 0).collect();
-    let (p, r) = interpolate_limit_points(&mesh, &targets, &movable, 200).unwrap();
+    let (p, r) =
+        interpolate_limit_points(&mesh, &RefineOptions::default(), &targets, &movable, 200)
+            .unwrap();
     for (v, (a, b)) in p.iter().zip(&mesh.positions).enumerate() {
         assert_eq!(a == b, !movable[v], "vertex {v}");
     }
     assert!(r < 1e-6, "residual over the movable vertices {r}");
-    assert!(interpolate_limit_points(&mesh, &targets[1..], &all, 3).is_err());
-    assert!(interpolate_limit_points(&mesh, &targets, &all[1..], 3).is_err());
+    assert!(
+        interpolate_limit_points(&mesh, &RefineOptions::default(), &targets[1..], &all, 3).is_err()
+    );
+    assert!(
+        interpolate_limit_points(&mesh, &RefineOptions::default(), &targets, &all[1..], 3).is_err()
+    );
 }
 
 #[test]

@@ -476,3 +476,161 @@ fn the_untangling_re_check_equals_a_check_from_scratch() {
         "the pushed corner must cross the cube"
     );
 }
+
+/// Half sides of the machined block of [`block_scan`].
+const BLOCK: [Real; 3] = [0.8, 0.5, 0.3];
+
+/// A fixed rotation (about an oblique axis), so that no edge of the block
+/// runs along a coordinate axis (or a voxel row of the initial model).
+fn block_rotation() -> nalgebra::Rotation3<Real> {
+    nalgebra::Rotation3::from_axis_angle(
+        &nalgebra::Unit::new_normalize(Vector3::new(1.0, 2.0, 3.0)),
+        0.7,
+    )
+}
+
+/// Distance of `p` (in the block's rotated frame) to the block's surface.
+fn block_distance(p: &Point3) -> Real {
+    let q = block_rotation().inverse() * p.coords;
+    let d = Vector3::from_fn(|i, _| q[i].abs() - BLOCK[i]);
+    let outside = d.map(|x| x.max(0.0)).norm();
+    outside + d.max().min(0.0).abs()
+}
+
+/// `n` points, area-uniform, on the surface of a rotated block (12 sharp
+/// edges at 90 degrees), with Gaussian noise of `sigma` along the normal.
+fn block_scan(n: usize, sigma: Real, seed: u64) -> PointCloud {
+    let mut rng = Rng(seed);
+    let [a, b, c] = BLOCK;
+    let areas = [b * c, a * c, a * b];
+    let total: Real = areas.iter().sum();
+    let pts = (0..n)
+        .map(|_| {
+            let mut pick = rng.uniform() * total;
+            let axis = (0..3)
+                .find(|&i| {
+                    pick -= areas[i];
+                    pick < 0.0
+                })
+                .unwrap_or(2);
+            let side = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+            let mut q = Vector3::from_fn(|i, _| BLOCK[i] * (2.0 * rng.uniform() - 1.0));
+            q[axis] = side * (BLOCK[axis] + sigma * rng.gauss());
+            Point3::from(block_rotation() * q)
+        })
+        .collect();
+    PointCloud::new(pts, None).unwrap()
+}
+
+/// Mean and largest distance of the fitted limit surface (with its creases)
+/// to the block.
+fn block_deviation(fit: &subdyn::fit::FitResult) -> (Real, Real) {
+    let r = Refiner::new(&fit.control, &subdyn::fit::crease_options(&fit.creases)).unwrap();
+    let (tess, _) = tessellate(&r, &fit.control.positions, 4).unwrap();
+    let d: Vec<Real> = tess.positions.iter().map(block_distance).collect();
+    (
+        d.iter().sum::<Real>() / d.len() as Real,
+        d.iter().cloned().fold(0.0, f64::max),
+    )
+}
+
+/// The edges of a machined block are found in its scan and tagged on the
+/// control mesh: every tagged edge lies along an edge of the block, the
+/// surface is closer to the block than the same fit without creases, the
+/// tags survive writing (OBJ `t crease` lines, a tag file beside a PLY),
+/// and a smooth sphere gets none.
+#[test]
+fn the_sharp_edges_of_a_block_are_tagged_as_creases() {
+    use subdyn::fit::init::InitParams;
+    use subdyn::fit::{FitStart, fit_from_start};
+    let cloud = block_scan(12_000, 0.001, 3);
+    let fit = |crease_angle: Real, tolerance_pct: Real| {
+        let params = FitParams {
+            crease_angle,
+            tolerance_pct,
+            ..Default::default()
+        };
+        let start = FitStart::Method(InitParams::default());
+        fit_from_start(&cloud, &start, &params, &mut |_, _, _| {})
+            .unwrap()
+            .result
+    };
+    let (sharp, smooth) = (fit(50.0, 0.1), fit(0.0, 0.1));
+    // With a tighter tolerance the tags go through refined levels.
+    let finer = fit(50.0, 0.03);
+    assert!(smooth.creases.is_empty());
+    assert!(
+        sharp.creases.len() >= 12,
+        "{} crease edges",
+        sharp.creases.len()
+    );
+    assert!(finer.report.levels.len() > sharp.report.levels.len());
+    assert!(
+        finer.creases.len() > sharp.creases.len(),
+        "{} crease edges after refinement, {} before",
+        finer.creases.len(),
+        sharp.creases.len()
+    );
+    // Each end of a tagged edge is near an edge of the block: off the
+    // surface by less than a tenth of the smallest side along two axes.
+    for fit in [&sharp, &finer] {
+        for &(i, j, s) in &fit.creases {
+            assert_eq!(s, subdyn::topology::SHARPNESS_INFINITE);
+            for v in [i, j] {
+                let q = block_rotation().inverse() * fit.control.positions[v as usize].coords;
+                let near_faces = (0..3)
+                    .filter(|&k| (q[k].abs() - BLOCK[k]).abs() < 0.06)
+                    .count();
+                assert!(near_faces >= 2, "crease vertex {v} at {q:?} is on no edge");
+            }
+        }
+    }
+    // Fewer control points, and closer.
+    assert!(sharp.control.num_vertices() < smooth.control.num_vertices());
+    let (mean_sharp, max_sharp) = block_deviation(&sharp);
+    let (mean_smooth, max_smooth) = block_deviation(&smooth);
+    // (Below the noise, finer levels fit the noise: compare with the smooth
+    // fit, not with level 0.)
+    let (mean_finer, _) = block_deviation(&finer);
+    assert!(mean_finer < mean_smooth);
+    println!(
+        "block: {} crease edges, {} control points; mean {mean_sharp:.5} max {max_sharp:.5} with them, {} control points, {mean_smooth:.5} {max_smooth:.5} without",
+        sharp.creases.len(),
+        sharp.control.num_vertices(),
+        smooth.control.num_vertices()
+    );
+    assert!(mean_sharp < 0.9 * mean_smooth);
+    assert!(max_sharp < max_smooth);
+
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("block.obj");
+    assert_eq!(
+        subdyn::io::write_control_mesh(&obj, &sharp.control, &sharp.creases).unwrap(),
+        None
+    );
+    assert_eq!(
+        subdyn::io::read_obj_tags(&obj).unwrap().tags.creases,
+        sharp.creases
+    );
+    assert_eq!(subdyn::io::read_mesh(&obj).unwrap(), sharp.control);
+    let ply = dir.path().join("block.ply");
+    let beside = subdyn::io::write_control_mesh(&ply, &sharp.control, &sharp.creases)
+        .unwrap()
+        .expect("a PLY control mesh gets its creases beside it");
+    assert_eq!(beside, dir.path().join("block.ply.creases"));
+    assert_eq!(
+        subdyn::io::read_tags(&beside).unwrap().creases,
+        sharp.creases
+    );
+
+    let sphere = sphere_scan(6000, 0.001, 4);
+    let start = FitStart::Method(InitParams::default());
+    let round = fit_from_start(&sphere, &start, &FitParams::default(), &mut |_, _, _| {})
+        .unwrap()
+        .result;
+    assert!(
+        round.creases.is_empty(),
+        "{} creases on a sphere",
+        round.creases.len()
+    );
+}

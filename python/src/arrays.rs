@@ -133,3 +133,18 @@ pub fn without_gil<T: Send>(
     })
     .map_err(py_err)
 }
+
+/// Sharp edges `(i, j, s)` as an `(m, 3)` float64 array (rows as the
+/// `creases` argument of `subdivide` and `LimitSurface` take them).
+pub fn crease_array<'py>(
+    py: Python<'py>,
+    creases: &[(u32, u32, f64)],
+) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = creases
+        .iter()
+        .flat_map(|&(i, j, s)| [f64::from(i), f64::from(j), s])
+        .collect();
+    let a =
+        Array2::from_shape_vec((creases.len(), 3), flat).unwrap_or_else(|_| Array2::zeros((0, 3)));
+    PyArray2::from_owned_array(py, a)
+}

@@ -10,10 +10,12 @@ use pyo3::types::PyDict;
 use serde_json::json;
 
 use subdyn::fit::init::{InitKind, InitParams};
-use subdyn::fit::{FitParams, FitStart, Refinement, ToleranceStat, fit_from_start};
+use subdyn::fit::{FitParams, FitStart, Refinement, ToleranceStat, crease_options, fit_from_start};
 use subdyn::mesh::{PointCloud, PolyMesh};
 
-use crate::arrays::{mesh, mesh_arrays, points, value_error, vector_array, vectors, without_gil};
+use crate::arrays::{
+    crease_array, mesh, mesh_arrays, points, value_error, vector_array, vectors, without_gil,
+};
 use crate::options::Options;
 use subdyn::limit::limit_surface_mesh;
 
@@ -31,6 +33,7 @@ const FIT_OPTIONS: &[&str] = &[
     "fairness",
     "untangle_rounds",
     "final_untangle_rounds",
+    "crease_angle",
     "init_resolution",
     "mass",
     "tess",
@@ -91,12 +94,18 @@ pub fn fit<'py>(
     };
     let (run, limit, report) = without_gil(py, threads, || {
         let run = fit_from_start(&cloud, &start, &params, &mut |_, _, _| {})?;
-        let limit = limit_surface_mesh(&run.result.control, &Default::default(), tess, quads)?;
+        let limit = limit_surface_mesh(
+            &run.result.control,
+            &crease_options(&run.result.creases),
+            tess,
+            quads,
+        )?;
         let mut report = json!({
             "command": "fit",
             "input": format!("an array of {n} points"),
             "output": null,
             "limit_out": null,
+            "crease_file": null,
         });
         if let Some(map) = report.as_object_mut() {
             map.extend(run.report(&params)?);
@@ -104,7 +113,14 @@ pub fn fit<'py>(
         }
         Ok((run, limit, report))
     })?;
-    result_dict(py, &run.init, &run.result.control, &limit, &report)
+    result_dict(
+        py,
+        &run.init,
+        &run.result.control,
+        &run.result.creases,
+        &limit,
+        &report,
+    )
 }
 
 /// `FitParams` from the options, with the CLI's defaults.
@@ -138,6 +154,7 @@ fn fit_params(o: &Options<'_, '_>) -> PyResult<FitParams> {
         fairness: o.f64("fairness", d.fairness)?,
         untangle_rounds: o.usize("untangle_rounds", d.untangle_rounds)?,
         final_untangle_rounds: o.usize("final_untangle_rounds", d.final_untangle_rounds)?,
+        crease_angle: o.f64("crease_angle", d.crease_angle)?,
         mass: o.f64("mass", d.mass)?,
         ..d
     };
@@ -151,12 +168,14 @@ pub fn result_dict<'py>(
     py: Python<'py>,
     init: &PolyMesh,
     control: &PolyMesh,
+    creases: &[(u32, u32, f64)],
     limit: &(PolyMesh, Vec<subdyn::math::Vector3>),
     report: &serde_json::Value,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("init", mesh_arrays(py, init))?;
     d.set_item("control", mesh_arrays(py, control))?;
+    d.set_item("creases", crease_array(py, creases))?;
     d.set_item("limit", mesh_arrays(py, &limit.0))?;
     d.set_item("limit_normals", vector_array(py, &limit.1))?;
     d.set_item("report", report.to_string())?;

@@ -8,12 +8,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use serde_json::json;
 
+use subdyn::fit::Refinement;
 use subdyn::fit::recover::{
     BONE_HU, InitialModel, RecoverParams, RecoverStart, SKIN_HU, initial_model, opened_at_box,
-    poor_result,
-    prepare_volume_owned, recover_shape,
+    poor_result, prepare_volume_owned, recover_shape,
 };
-use subdyn::fit::Refinement;
 use subdyn::forces::BoundaryModel;
 use subdyn::math::Point3;
 use subdyn::volume::Volume;
@@ -185,7 +184,7 @@ pub fn recover<'py>(
         });
         Ok((init, control, limit, report))
     })?;
-    result_dict(py, &init, &control, &limit, &report)
+    result_dict(py, &init, &control, &[], &limit, &report)
 }
 
 /// The iso-value of `iso=` or of `preset=` ("skin" or "bone", Hounsfield

@@ -80,6 +80,10 @@ class FitResult:
     so it pickles.
 
     ``control_faces`` is a list of int64 arrays (any polygon size);
+    ``control_creases`` is (m, 3) float64, rows ``(i, j, sharpness)``: the
+    control edges tagged as sharp creases (``fit``'s ``crease_angle``; the
+    limit surface is the control mesh's with them, as
+    ``LimitSurface(control_vertices, control_faces, creases=control_creases)``);
     ``limit_triangles`` is (k, 3) int64 (``limit_quads`` (k, 4) instead when
     the call had ``quads=True``); ``report`` equals the JSON of the CLI's
     ``--report`` (with ``input`` naming the array and no output paths).
@@ -94,6 +98,7 @@ class FitResult:
     init_vertices: np.ndarray
     init_faces: List[np.ndarray]
     limit_quads: Optional[np.ndarray] = field(default=None)
+    control_creases: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     @property
     def limit_faces(self) -> np.ndarray:
@@ -101,8 +106,11 @@ class FitResult:
         return self.limit_triangles if self.limit_triangles is not None else self.limit_quads
 
     def write_control(self, path: str) -> None:
-        """Writes the control mesh (format from the extension)."""
-        write_mesh(path, self.control_vertices, self.control_faces)
+        """Writes the control mesh (format from the extension) with its
+        creases: ``t crease`` lines in an OBJ file, else ``PATH.creases``
+        beside it (when there are any)."""
+        write_mesh(path, self.control_vertices, self.control_faces,
+                   creases=self.control_creases if len(self.control_creases) else None)
 
     def write_limit(self, path: str, normals: bool = True) -> None:
         """Writes the limit surface (with its unit normals unless ``normals=False``)."""
@@ -125,6 +133,7 @@ def _result(raw: Dict[str, Any], quads: bool) -> FitResult:
         report=json.loads(raw["report"]),
         init_vertices=iv,
         init_faces=_face_list(ifv, ifo),
+        control_creases=raw["creases"],
     )
 
 
@@ -137,6 +146,7 @@ def fit(points: Any, normals: Any = None, **options: Any) -> FitResult:
     ``refine`` ("adaptive" or "uniform"), ``refine_significance``,
     ``refine_off_data``, ``tension``, ``bending``, ``fairness``,
     ``untangle_rounds``, ``final_untangle_rounds``, ``mass``,
+    ``crease_angle`` (50 degrees; 0 turns sharp creases off),
     ``init`` ("auto", "closed", "open", "occupancy", or a ``(vertices,
     faces)`` control mesh), ``init_resolution``, ``tess`` (4, the limit
     surface's samples per quad edge), ``quads`` (False), and ``threads``
@@ -292,11 +302,15 @@ def read_points(path: str) -> Tuple[np.ndarray, Optional[np.ndarray]]:
     return _subdyn.read_points(str(path))
 
 
-def write_mesh(path: str, vertices: Any, faces: Faces, normals: Any = None) -> None:
+def write_mesh(path: str, vertices: Any, faces: Faces, normals: Any = None,
+               creases: Any = None) -> None:
     """Writes a mesh, format from the extension (.obj, .ply, .off), through a
-    temporary file so a failure leaves nothing behind."""
+    temporary file so a failure leaves nothing behind. A control mesh's
+    ``creases`` ((m, 3) rows ``(i, j, sharpness)``) go into an OBJ file as
+    OpenSubdiv ``t crease`` lines, beside other formats as ``PATH.creases``."""
     nrm = None if normals is None else _points(normals, "normals")
-    _subdyn.write_mesh(str(path), *_mesh_args(vertices, faces), nrm)
+    cr = None if creases is None else np.ascontiguousarray(creases, dtype=np.float64)
+    _subdyn.write_mesh(str(path), *_mesh_args(vertices, faces), nrm, cr)
 
 
 def __getattr__(name: str):

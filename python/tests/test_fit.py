@@ -36,8 +36,9 @@ def test_fit_equals_cli(tmp_path, sphere_scan, sphere_fit):
     cli = json.load(open(tmp_path / "cli.json"))
     assert sorted(cli) == sorted(r.report)
     assert r.report["input"] == f"an array of {len(points)} points"
-    cli = {k: v for k, v in cli.items() if k not in ("input", "output", "limit_out")}
-    ours = {k: v for k, v in r.report.items() if k not in ("input", "output", "limit_out")}
+    paths = ("input", "output", "limit_out", "crease_file")
+    cli = {k: v for k, v in cli.items() if k not in paths}
+    ours = {k: v for k, v in r.report.items() if k not in paths}
     assert without_timings(ours) == without_timings(cli)
     assert r.report["fit"]["levels"], "the report lists the levels"
 
@@ -90,3 +91,45 @@ def test_limit_surface_of_a_closed_scan_is_watertight(sphere_fit):
     assert mesh.is_watertight()
     assert mesh.is_orientable()
     assert isinstance(mesh, o3d.geometry.TriangleMesh)
+
+
+def test_sharp_creases_come_back_with_the_fit(tmp_path):
+    """A machined plate's sharp edges: the Python fit's ``control_creases``
+    are the CLI's ``t crease`` lines, they round-trip through OBJ and a tag
+    file beside a PLY, and the limit surface is the one with them."""
+    path = tmp_path / "plate.ply"
+    run("data-gen", "scan", "plate", "-o", path, "--noise", 0.001, "--views", 8,
+        "--resolution", "128,96", "--seed", 1)
+    points, _ = subdyn.read_points(path)
+    r = subdyn.fit(points)
+    assert r.control_creases.shape[1] == 3 and len(r.control_creases) >= 12
+    assert r.report["creases"] == len(r.control_creases)
+    assert (r.control_creases[:, 2] == 10).all()
+    run("subdyn", "fit", path, "-o", tmp_path / "cli.obj", "--quiet")
+    tags = [line.split()[3:] for line in open(tmp_path / "cli.obj") if line.startswith("t crease")]
+    assert np.array_equal(np.array(tags, dtype=float), r.control_creases)
+    smooth = subdyn.fit(points, crease_angle=0)
+    assert smooth.control_creases.shape == (0, 3)
+
+    r.write_control(tmp_path / "ours.obj")
+    assert open(tmp_path / "ours.obj").read() == open(tmp_path / "cli.obj").read()
+    r.write_control(tmp_path / "ours.ply")
+    beside = [line.split() for line in open(tmp_path / "ours.ply.creases")
+              if not line.startswith("#")]
+    assert np.array_equal(np.array(beside, dtype=float), r.control_creases)
+
+    # The centres of the quads are vertices of the limit tessellation (tess 4)
+    # with the creases, not without them.
+    from scipy.spatial import cKDTree
+    quads = np.array([f for f, face in enumerate(r.control_faces) if len(face) == 4])
+    half = np.full(len(quads), 0.5)
+    tree = cKDTree(r.limit_vertices)
+    diagonal = np.linalg.norm(points.max(0) - points.min(0))
+    gaps = []
+    for creases in (r.control_creases, None):
+        surface = subdyn.LimitSurface(r.control_vertices, r.control_faces, creases=creases)
+        gaps.append(tree.query(surface.evaluate(quads, half, half).p)[0].max())
+    assert gaps[0] <= 1e-9 * diagonal < 1e-4 * diagonal < gaps[1]
+    with pytest.raises(ValueError, match="without normals"):
+        subdyn.write_mesh(tmp_path / "n.obj", r.control_vertices, r.control_faces,
+                          normals=r.control_vertices, creases=r.control_creases)

@@ -9,9 +9,10 @@ use serde_json::json;
 
 use subdyn::fit::init::InitParams;
 use subdyn::fit::{
-    FitParams, FitReport, FitStart, Refinement, ToleranceStat, fit_from_start, stat_name,
+    FitParams, FitReport, FitStart, Refinement, ToleranceStat, crease_options, fit_from_start,
+    stat_name,
 };
-use subdyn::io::{read_points, write_mesh};
+use subdyn::io::{read_points, write_control_mesh, write_mesh};
 use subdyn::limit::limit_surface_mesh;
 use subdyn::subdivision::{RefineOptions, Refiner};
 
@@ -107,6 +108,13 @@ pub struct FitArgs {
     /// the crossings get fewer (0 turns it off).
     #[arg(long, value_name = "N", default_value_t = FitParams::default().final_untangle_rounds)]
     pub final_untangle_rounds: usize,
+    /// Sharp creases: after the last level, control edges along which the
+    /// scan's two sides are flat and meet at this angle or more (degrees)
+    /// are tagged infinitely sharp and kept if the refit is not worse. An
+    /// OBJ output carries them as `t crease` lines; other formats get
+    /// OUTPUT.creases beside them (0 turns creases off).
+    #[arg(long, value_name = "DEG", default_value_t = FitParams::default().crease_angle)]
+    pub crease_angle: f64,
     /// Resolution of the automatic initial model: voxels along the longest
     /// axis of the occupancy cage, grid cells of the open grid. Holes and gaps
     /// narrower than about 4 voxels close up; raise it for thin gaps.
@@ -175,6 +183,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
         fairness: args.fairness,
         untangle_rounds: args.untangle_rounds,
         final_untangle_rounds: args.final_untangle_rounds,
+        crease_angle: args.crease_angle,
         mass: args.mass,
         ..Default::default()
     };
@@ -212,13 +221,20 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     }
     let result = &run.result;
     progress.stage(format!("writing {}", args.output.display()));
-    write_mesh(&args.output, &result.control, None).map_err(|e| about_file(e, &args.output))?;
+    let crease_file = write_control_mesh(&args.output, &result.control, &result.creases)
+        .map_err(|e| about_file(e, &args.output))?;
     let mut written = Written::new();
     written.add(&args.output, "control mesh");
+    if let Some(path) = &crease_file {
+        written.add(
+            path,
+            "crease tags of the control mesh (--creases reads them)",
+        );
+    }
     if let Some(path) = &args.limit_out {
         let (surf, normals) = limit_surface_mesh(
             &result.control,
-            &RefineOptions::default(),
+            &crease_options(&result.creases),
             args.tess,
             args.faces.quads,
         )?;
@@ -236,6 +252,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             "input": name,
             "output": args.output.display().to_string(),
             "limit_out": args.limit_out.as_ref().map(|p| p.display().to_string()),
+            "crease_file": crease_file.as_ref().map(|p| p.display().to_string()),
         });
         if let Some(map) = value.as_object_mut() {
             map.extend(run.report(&params)?);

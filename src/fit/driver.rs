@@ -36,13 +36,14 @@ use crate::limit::{ClosestPointEngine, ClosestPointParams, QuadtreeCache};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::{PointCloud, PolyMesh};
 use crate::subdivision::{CornerImage, RefineOptions, Refiner};
-use crate::topology::face_of_corner;
+use crate::topology::{SHARPNESS_INFINITE, face_of_corner};
 
 use super::init::outliers::{Screening, screen};
 use super::init::voxel_surface::taubin_smoothed_where;
 
+use super::creases::{Crease, crease_edges, refined_creases};
 use super::fairness::{umbrella_matrix, vertex_rings};
-use super::levels::{fitted_worse, split_within, stop_after_level};
+use super::levels::{Split, fitted_worse, split_within, stop_after_level};
 use super::quality::{CHECK_RATE, SelfIntersections, assess};
 use super::refine_marks::{face_residuals, faces_above_noise, faces_off_data};
 use super::sampling::{shuffled_order, surface_samples, trimmed_rms};
@@ -84,8 +85,69 @@ enum Carried {
 pub struct FitResult {
     /// The control mesh of the finest level reached.
     pub control: PolyMesh,
+    /// Its sharp edges `(i, j, s)` (`i < j`, `s` = [`SHARPNESS_INFINITE`]):
+    /// the creases found in the data ([`FitParams::crease_angle`]); the
+    /// limit surface is `control`'s with these tags
+    /// ([`crease_options`]).
+    pub creases: Vec<Crease>,
     /// Per-level report.
     pub report: FitReport,
+}
+
+/// The refinement options of a fitted control mesh with these `creases`.
+pub fn crease_options(creases: &[Crease]) -> RefineOptions {
+    RefineOptions {
+        creases: creases.to_vec(),
+        ..Default::default()
+    }
+}
+
+/// The last level as fitted without creases, while it is fitted again with
+/// them.
+struct WithoutCreases {
+    mesh: PolyMesh,
+    dist: Vec<Real>,
+    report: LevelReport,
+    found: usize,
+}
+
+/// The control edges of `mesh` along creases of the `data`
+/// ([`crease_edges`]), with the surface points by their midpoints found on
+/// `mesh`'s limit surface.
+fn detect_creases(
+    mesh: &PolyMesh,
+    data: &[Point3],
+    miss: &[Real],
+    data_tree: &ImmutableKdTree<Real, 3>,
+    noise: Real,
+    angle: Real,
+    quadtrees: &QuadtreeCache,
+) -> Result<Vec<(u32, u32)>> {
+    let refiner = Refiner::new(mesh, &RefineOptions::default())?;
+    let engine = ClosestPointEngine::with_quadtrees(
+        &refiner,
+        &mesh.positions,
+        &ClosestPointParams {
+            tolerance: 1e-7,
+            ..Default::default()
+        },
+        quadtrees.clone(),
+    )?;
+    let level = &refiner.level;
+    let p = &mesh.positions;
+    let mids: Vec<Point3> = level
+        .edge_verts
+        .iter()
+        .map(|&[a, b]| Point3::from((p[a as usize].coords + p[b as usize].coords) / 2.0))
+        .collect();
+    let surface: Vec<Point3> = engine
+        .closest_points(&mids)?
+        .iter()
+        .map(|c| c.point)
+        .collect();
+    Ok(crease_edges(
+        level, p, &surface, data, miss, data_tree, noise, angle,
+    ))
 }
 
 /// Fits the limit surface of a control mesh, starting from `init`, to the
@@ -167,17 +229,24 @@ pub fn fit_screened_cloud(
     let mut refinement = String::from("initial");
     // The parent of an adaptive level, kept to refine it uniformly instead
     // should the adaptive level fit worse.
-    let mut adaptive_parent: Option<PolyMesh> = None;
+    let mut adaptive_parent: Option<(PolyMesh, Vec<Crease>)> = None;
     // Most local structures at extraordinary vertices recur from level to
     // level: their quadtrees are built once.
     let quadtrees = QuadtreeCache::default();
-    // The distances of the last level kept, to assess the result with.
+    // The distances of the last level kept, to assess the result with, and
+    // its closest-point answers (of the points it used).
     let mut final_dist: Vec<Real> = Vec::new();
+    let mut final_hints: Vec<(u32, [Real; 2])> = Vec::new();
+    // The sharp creases of the control mesh (`super::creases`): found after
+    // level 0, which is then fitted again with them (`crease_pass` holds it
+    // as fitted without), and carried through the refinements.
+    let mut creases: Vec<Crease> = Vec::new();
+    let mut crease_pass: Option<WithoutCreases> = None;
     let (converged, stop_reason) = loop {
         let level = levels.len();
         let level_start = Instant::now();
         check_level_memory(level, mesh.num_faces())?;
-        let refiner = Refiner::new(&mesh, &RefineOptions::default())?;
+        let refiner = Refiner::new(&mesh, &crease_options(&creases))?;
         let mut engine = ClosestPointEngine::with_quadtrees(
             &refiner,
             &mesh.positions,
@@ -414,7 +483,8 @@ pub fn fit_screened_cloud(
             rejected: w.iter().filter(|&&w| w == 0.0).count() as Real / n_all,
             refinement: std::mem::take(&mut refinement),
         };
-        if let (Some(parent), Some(before)) = (adaptive_parent.take(), levels.last())
+        if let (Some((parent, parent_creases)), Some(before)) =
+            (adaptive_parent.take(), levels.last())
             && fitted_worse(
                 (report.error.rms, report.error.p95),
                 (before.error.rms, before.error.p95),
@@ -427,9 +497,10 @@ pub fn fit_screened_cloud(
                 report.control_points, report.error.p95_pct, before.error.p95_pct
             );
             carried_hints = None;
-            let h = Refiner::new(&parent, &RefineOptions::default())?.refine_uniform(1)?;
+            let h = Refiner::new(&parent, &crease_options(&parent_creases))?.refine_uniform(1)?;
             if h.level(1).num_vertices as Real > params.max_control_fraction * n_all {
                 mesh = parent;
+                creases = parent_creases;
                 break (
                     false,
                     format!(
@@ -441,10 +512,67 @@ pub fn fit_screened_cloud(
             }
             let p1 = h.stencil(0).apply(&parent.positions)?;
             mesh = h.mesh(1, p1);
+            creases = refined_creases(&h, &mesh, None, &parent_creases);
             continue;
         }
         levels.push(report);
         final_dist.clone_from(&dist);
+        if let Some(without) = crease_pass.take() {
+            // The level fitted again with creases: keep the better fit, as
+            // one level.
+            let with = levels.pop().expect("the level just pushed");
+            let (e, before) = (&with.error, &without.report.error);
+            let (kept, note) = if fitted_worse((e.rms, e.p95), (before.rms, before.p95)) {
+                creases.clear();
+                mesh = without.mesh;
+                final_dist = without.dist;
+                (without.report.clone(), "tried and dropped")
+            } else {
+                final_hints.clone_from(&last_hints);
+                (with.clone(), "tagged")
+            };
+            levels.push(LevelReport {
+                level: without.report.level,
+                refinement: format!(
+                    "{}; {} crease edges {note} (95th percentile {:.3} % with, {:.3} % without)",
+                    without.report.refinement, without.found, e.p95_pct, before.p95_pct
+                ),
+                ..kept
+            });
+        } else {
+            final_hints.clone_from(&last_hints);
+            if level == 0 && params.crease_angle > 0.0 {
+                let miss: Vec<Real> = data_index.iter().map(|&i| final_dist[i]).collect();
+                let found = detect_creases(
+                    &mesh,
+                    &data,
+                    &miss,
+                    &data_tree,
+                    data_noise,
+                    params.crease_angle,
+                    &quadtrees,
+                )?;
+                if !found.is_empty() {
+                    crease_pass = Some(WithoutCreases {
+                        mesh: mesh.clone(),
+                        dist: final_dist.clone(),
+                        found: found.len(),
+                        report: levels.pop().expect("the level just pushed"),
+                    });
+                    creases = found
+                        .into_iter()
+                        .map(|(a, b)| (a, b, SHARPNESS_INFINITE))
+                        .collect();
+                    carried_hints = Some(
+                        final_hints
+                            .iter()
+                            .map(|&(p, st)| Carried::Patch(p, st))
+                            .collect(),
+                    );
+                    continue;
+                }
+            }
+        }
         let stat = params.tolerance_stat;
         let noise_pct = 100.0 * data_noise / diameter;
         let met = if error.pct(stat) <= params.tolerance_pct {
@@ -478,6 +606,7 @@ pub fn fit_screened_cloud(
             break stop;
         }
         let h = refiner.refine_uniform(1)?;
+        let next_creases;
         let next = match params.refinement {
             Refinement::Uniform => {
                 refinement = "uniform".into();
@@ -490,7 +619,9 @@ pub fn fit_screened_cloud(
                         .collect(),
                 );
                 let p1 = h.stencil(0).apply(&mesh.positions)?;
-                h.mesh(1, p1)
+                let next = h.mesh(1, p1);
+                next_creases = refined_creases(&h, &next, None, &creases);
+                next
             }
             Refinement::Adaptive => {
                 // The points left out of the springs do not count either.
@@ -543,7 +674,13 @@ pub fn fit_screened_cloud(
                         .then(a.cmp(&b))
                 });
                 let cap = params.max_control_fraction * n_all;
-                let (marks, local, left) = split_within(&mesh, &h, &rank, cap)?;
+                let Split {
+                    marks,
+                    local,
+                    creases: local_creases,
+                    left,
+                } = split_within(&mesh, &h, &creases, &rank, cap)?;
+                next_creases = local_creases;
                 refinement = format!(
                     "adaptive: {} of {} faces split{}{}",
                     marks.iter().filter(|&&m| m).count(),
@@ -559,7 +696,7 @@ pub fn fit_screened_cloud(
                         String::new()
                     }
                 );
-                adaptive_parent = Some(mesh.clone());
+                adaptive_parent = Some((mesh.clone(), creases.clone()));
                 carried_hints = Some(
                     last_hints
                         .iter()
@@ -587,13 +724,15 @@ pub fn fit_screened_cloud(
             );
         }
         mesh = next;
+        creases = next_creases;
     };
     let (crossings, final_untangling) =
-        untangle_after_fit(&mut mesh, params.final_untangle_rounds)?;
+        untangle_after_fit(&mut mesh, &creases, params.final_untangle_rounds)?;
     let kept_dist: Vec<Real> = data_index.iter().map(|&i| final_dist[i]).collect();
     let quality = assess(&mesh, crossings, &data, &data_tree, &kept_dist, diameter)?;
     Ok(FitResult {
         control: mesh,
+        creases,
         report: FitReport {
             quality,
             noise: data_noise,
@@ -645,9 +784,10 @@ fn untangled(
 /// self-intersections (for [`assess`]) and what was done.
 fn untangle_after_fit(
     mesh: &mut PolyMesh,
+    creases: &[Crease],
     max_rounds: usize,
 ) -> Result<(SelfIntersections, Untangling)> {
-    let refiner = Refiner::new(mesh, &RefineOptions::default())?;
+    let refiner = Refiner::new(mesh, &crease_options(creases))?;
     let start = mesh.positions.clone();
     let mut best = SelfIntersections::of(&refiner, &start, CHECK_RATE)?;
     let mut done = Untangling {

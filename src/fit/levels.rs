@@ -2,6 +2,8 @@
 //! volume recovery share (Qin, Mandal, Vemuri 1998, §6: the model settles
 //! at a level, and is subdivided while its error is above the tolerance).
 
+use super::crease_options;
+use super::creases::{Crease, refined_creases};
 use crate::error::Result;
 use crate::limit::{interpolate_limit_points, limit_stencil};
 use crate::math::{Point3, Real};
@@ -54,47 +56,62 @@ pub(crate) fn fitted_worse(last: (Real, Real), parent: (Real, Real)) -> bool {
     last.0 > parent.0 && last.1 > parent.1
 }
 
+/// What [`split_within`] made.
+pub(crate) struct Split {
+    /// The split faces (closed by [`close_marks`]).
+    pub marks: Vec<bool>,
+    /// The refinement.
+    pub local: LocalRefinement,
+    /// Its creases ([`refined_creases`]).
+    pub creases: Vec<Crease>,
+    /// How many ranked faces were left unsplit for the budget.
+    pub left: usize,
+}
+
 /// [`locally_refined`] with the first faces of `rank` split (closed by
 /// [`close_marks`]): all of them when the result has at most `cap` control
 /// points, else the longest prefix that keeps within it (found by
 /// bisection; the count grows with the prefix), else all of them, for the
-/// caller's budget test to stop at. Returns the closed marks, the
-/// refinement and how many ranked faces were left unsplit.
+/// caller's budget test to stop at. `creases` are `mesh`'s (`h` is refined
+/// with them).
 pub(crate) fn split_within(
     mesh: &PolyMesh,
     h: &Hierarchy,
+    creases: &[Crease],
     rank: &[usize],
     cap: Real,
-) -> Result<(Vec<bool>, LocalRefinement, usize)> {
-    let split = |k: usize| -> Result<(Vec<bool>, LocalRefinement)> {
+) -> Result<Split> {
+    let split = |k: usize| -> Result<Split> {
         let mut marks = vec![false; mesh.num_faces()];
         for &f in &rank[..k] {
             marks[f] = true;
         }
         let marks = close_marks(h.level(0), &marks);
-        let local = locally_refined(mesh, h, &marks)?;
-        Ok((marks, local))
+        let (local, creases) = locally_refined(mesh, h, creases, &marks)?;
+        Ok(Split {
+            marks,
+            local,
+            creases,
+            left: rank.len() - k,
+        })
     };
     let all = split(rank.len())?;
-    if all.1.mesh.num_vertices() as Real <= cap {
-        return Ok((all.0, all.1, 0));
+    if all.local.mesh.num_vertices() as Real <= cap {
+        return Ok(all);
     }
     // The longest prefix within the budget: `lo` fits (or is 0), `hi` does not.
     let (mut lo, mut hi, mut best) = (0, rank.len(), None);
     while hi - lo > 1 {
         let mid = (lo + hi) / 2;
         let tried = split(mid)?;
-        if tried.1.mesh.num_vertices() as Real <= cap {
+        if tried.local.mesh.num_vertices() as Real <= cap {
             lo = mid;
             best = Some(tried);
         } else {
             hi = mid;
         }
     }
-    Ok(match best {
-        Some((marks, local)) => (marks, local, rank.len() - lo),
-        None => (all.0, all.1, 0),
-    })
+    Ok(best.unwrap_or(all))
 }
 
 /// `mesh` with its `marked` faces split ([`refine_marked`]; `h` is one
@@ -102,9 +119,16 @@ pub(crate) fn split_within(
 /// limit point of every vertex of a split or changed face lies on `mesh`'s
 /// limit surface where the vertex it stands for in uniform refinement has
 /// its limit point ([`interpolate_limit_points`]; the other vertices keep
-/// their positions, so the surface away from the split faces is unchanged).
-fn locally_refined(mesh: &PolyMesh, h: &Hierarchy, marked: &[bool]) -> Result<LocalRefinement> {
+/// their positions, so the surface away from the split faces is unchanged),
+/// with its creases (`mesh`'s are `creases`, [`refined_creases`]).
+fn locally_refined(
+    mesh: &PolyMesh,
+    h: &Hierarchy,
+    creases: &[Crease],
+    marked: &[bool],
+) -> Result<(LocalRefinement, Vec<Crease>)> {
     let mut local = refine_marked(mesh, h.level(0), h.stencil(0), marked)?;
+    let child_creases = refined_creases(h, &local.mesh, Some(&local.uniform_vertex), creases);
     let parent_limit = limit_stencil(h, 1)?.apply(&mesh.positions)?;
     let targets: Vec<Point3> = local
         .uniform_vertex
@@ -120,7 +144,12 @@ fn locally_refined(mesh: &PolyMesh, h: &Hierarchy, marked: &[bool]) -> Result<Lo
             }
         }
     }
-    (local.mesh.positions, _) =
-        interpolate_limit_points(&local.mesh, &targets, &movable, LIMIT_ITERATIONS)?;
-    Ok(local)
+    (local.mesh.positions, _) = interpolate_limit_points(
+        &local.mesh,
+        &crease_options(&child_creases),
+        &targets,
+        &movable,
+        LIMIT_ITERATIONS,
+    )?;
+    Ok((local, child_creases))
 }

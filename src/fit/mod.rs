@@ -3,6 +3,7 @@
 //! tension keeps it fair, and when the model settles above the tolerance it
 //! is subdivided and the fit continues at the finer level.
 
+mod creases;
 mod driver;
 pub mod fairness;
 pub mod init;
@@ -16,7 +17,8 @@ mod sampling;
 mod start;
 mod system;
 
-pub use driver::{FitResult, fit_point_cloud, fit_screened_cloud};
+pub use creases::Crease;
+pub use driver::{FitResult, crease_options, fit_point_cloud, fit_screened_cloud};
 pub use params::{FitParams, Refinement, ToleranceStat};
 pub use report::{ErrorStats, FitReport, LevelReport, Untangling};
 pub use start::{FitRun, FitStart, MIN_FIT_POINTS, fit_from_start, stat_name};

@@ -51,6 +51,8 @@ impl FitRun {
             "tolerance_stat".into(),
             json!(stat_name(params.tolerance_stat)),
         );
+        map.insert("crease_angle".into(), json!(params.crease_angle));
+        map.insert("creases".into(), json!(self.result.creases.len()));
         map.insert("fit".into(), fit);
         Ok(map)
     }

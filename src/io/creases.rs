@@ -4,8 +4,10 @@
 
 use std::path::Path;
 
+use super::atomic::atomic_write;
 use super::source::read_input;
 use super::text::{content_lines, parse_count, parse_real};
+use super::write::write_real;
 use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::subdivision::{BoundaryRule, RefineOptions, TriangleRule};
@@ -238,6 +240,32 @@ pub(crate) fn parse_obj_tags(bytes: &[u8], path: &Path) -> Result<ObjTags> {
 pub fn read_obj_tags(path: impl AsRef<Path>) -> Result<ObjTags> {
     let path = path.as_ref();
     parse_obj_tags(&read_input(path)?, path)
+}
+
+/// Writes `tags` as a tag file that [`read_tags`] reads back: a comment
+/// line, then `i j s` per crease, `v i s` per corner and `h f` per hole
+/// (0-based), atomically.
+pub fn write_tags(path: impl AsRef<Path>, tags: &SubdivisionTags) -> Result<()> {
+    atomic_write(path.as_ref(), |w| {
+        writeln!(
+            w,
+            "# subdivision tags written by subdyn: i j s (crease), v i s (corner), h f (hole); 0-based, s >= 10 infinitely sharp"
+        )?;
+        for &(i, j, s) in &tags.creases {
+            write!(w, "{i} {j} ")?;
+            write_real(w, s)?;
+            writeln!(w)?;
+        }
+        for &(v, s) in &tags.corners {
+            write!(w, "v {v} ")?;
+            write_real(w, s)?;
+            writeln!(w)?;
+        }
+        for &f in &tags.holes {
+            writeln!(w, "h {f}")?;
+        }
+        Ok(())
+    })
 }
 
 /// A sharpness `s ≥ 0` (or `inf`).

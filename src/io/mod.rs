@@ -31,7 +31,7 @@ mod xyz;
 
 pub use atomic::{atomic_write, check_writable, remove_temporary_files};
 pub use batch::{OutputBatch, check_output_dir_path, create_output_dir};
-pub use creases::{ObjTags, SubdivisionTags, read_obj_tags, read_tags};
+pub use creases::{ObjTags, SubdivisionTags, read_obj_tags, read_tags, write_tags};
 pub use format::MeshFormat;
 pub use lattice::{
     LATTICE_FORMAT, is_lattice_file, lattice_from_json, lattice_to_json, read_lattice,
@@ -43,4 +43,4 @@ pub use read::{
 pub(crate) use source::open_regular;
 pub use source::read_input;
 pub use volume::{VolumeFile, VolumeFormat, VolumeReadOptions, read_volume};
-pub use write::{write_mesh, write_points};
+pub use write::{write_control_mesh, write_mesh, write_mesh_with_creases, write_points};

@@ -137,6 +137,11 @@ pub(crate) fn write_obj(w: &mut dyn Write, geometry: &Geometry) -> std::io::Resu
         }
         w.write_all(b"\n")?;
     }
+    for &(i, j, sharpness) in geometry.creases {
+        write!(w, "t crease 2/1/0 {i} {j} ")?;
+        write_real(w, sharpness)?;
+        w.write_all(b"\n")?;
+    }
     Ok(())
 }
 

@@ -2,12 +2,13 @@
 //! extension, compress for `.gz`, and write atomically.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use flate2::Compression;
 use flate2::write::GzEncoder;
 
 use super::atomic::atomic_write;
+use super::creases::{SubdivisionTags, write_tags};
 use super::format::{MeshFormat, is_gzip_path};
 use super::{obj, off, ply, xyz};
 use crate::error::{Error, Result};
@@ -22,6 +23,9 @@ pub(crate) struct Geometry<'a> {
     pub normals: Option<&'a [Vector3]>,
     /// The mesh whose faces are written (its positions are `positions`).
     pub mesh: Option<&'a PolyMesh>,
+    /// Sharp edges `(i, j, s)` of the mesh: written by the OBJ writer only,
+    /// as OpenSubdiv's `t crease` tags.
+    pub creases: &'a [(u32, u32, Real)],
 }
 
 impl Geometry<'_> {
@@ -64,16 +68,67 @@ pub fn write_mesh(
     mesh: &PolyMesh,
     normals: Option<&[Vector3]>,
 ) -> Result<()> {
+    write_mesh_with_creases(path, mesh, normals, &[])
+}
+
+/// [`write_mesh`] with sharp edges `(i, j, s)`: an OBJ file carries them as
+/// OpenSubdiv's tags, one `t crease 2/1/0 i j s` line each (0-based
+/// indices, `s ≥ 10` infinitely sharp), which [`super::read_obj_tags`] and
+/// every verb that reads a control mesh apply; mesh readers without
+/// subdivision skip `t` lines. The other formats have no place for them
+/// ([`write_control_mesh`] puts them in a tag file beside the mesh).
+pub fn write_mesh_with_creases(
+    path: impl AsRef<Path>,
+    mesh: &PolyMesh,
+    normals: Option<&[Vector3]>,
+    creases: &[(u32, u32, Real)],
+) -> Result<()> {
     let path = path.as_ref();
     let format = MeshFormat::from_path(path)?;
     mesh.validate()?;
     check_normals(normals, mesh.num_vertices())?;
+    let n = mesh.num_vertices();
+    if let Some(&(i, j, s)) = creases
+        .iter()
+        .find(|&&(i, j, s)| i as usize >= n || j as usize >= n || i == j || s.is_nan() || s < 0.0)
+    {
+        return Err(Error::Input(format!(
+            "crease {i} {j} {s} is not an edge sharpness of a mesh of {n} vertices"
+        )));
+    }
     let geometry = Geometry {
         positions: &mesh.positions,
         normals,
         mesh: Some(mesh),
+        creases,
     };
     write_geometry(path, format, &geometry)
+}
+
+/// Writes a control mesh with its sharp edges `(i, j, s)`: an OBJ file
+/// carries them ([`write_mesh_with_creases`]); any other format gets them
+/// in a tag file beside it, `PATH.creases` (`i j s` lines, [`write_tags`]),
+/// whose path is returned. Without creases only the mesh is written.
+pub fn write_control_mesh(
+    path: impl AsRef<Path>,
+    mesh: &PolyMesh,
+    creases: &[(u32, u32, Real)],
+) -> Result<Option<PathBuf>> {
+    let path = path.as_ref();
+    let obj = MeshFormat::from_path(path)? == MeshFormat::Obj;
+    write_mesh_with_creases(path, mesh, None, if obj { creases } else { &[] })?;
+    if obj || creases.is_empty() {
+        return Ok(None);
+    }
+    let mut name = path.as_os_str().to_owned();
+    name.push(".creases");
+    let tags_path = PathBuf::from(name);
+    let tags = SubdivisionTags {
+        creases: creases.to_vec(),
+        ..Default::default()
+    };
+    write_tags(&tags_path, &tags)?;
+    Ok(Some(tags_path))
 }
 
 /// Writes the points of `cloud` (and its normals, when it has them) in the
@@ -94,6 +149,7 @@ pub fn write_points(path: impl AsRef<Path>, cloud: &PointCloud) -> Result<()> {
         positions: &cloud.positions,
         normals: cloud.normals.as_deref(),
         mesh: None,
+        creases: &[],
     };
     write_geometry(path, format, &geometry)
 }

@@ -25,6 +25,7 @@ use super::limit_stencil;
 /// stops a local change from rippling over the whole mesh.
 pub fn interpolate_limit_points(
     mesh: &PolyMesh,
+    options: &RefineOptions,
     targets: &[Point3],
     movable: &[bool],
     iterations: usize,
@@ -38,7 +39,7 @@ pub fn interpolate_limit_points(
         )));
     }
     // One level more lets `limit_stencil` use masks at vertices of n-gons.
-    let h = Refiner::new(mesh, &RefineOptions::default())?.refine_uniform(1)?;
+    let h = Refiner::new(mesh, options)?.refine_uniform(1)?;
     let l = limit_stencil(&h, 0)?;
     let mut p = mesh.positions.clone();
     let mut lp = vec![Point3::origin(); p.len()];

@@ -253,7 +253,7 @@ fn shares_a_sheet(p: &Vector3, others: &[Vector3], limit: impl Fn(Real) -> Real)
 /// Centroid, unit normal (smallest principal axis) and RMS residual of the
 /// least-squares plane of `pts`; `None` for fewer than 3 points or (nearly)
 /// collinear ones.
-fn plane(pts: &[Vector3]) -> Option<(Vector3, Vector3, Real)> {
+pub(crate) fn plane(pts: &[Vector3]) -> Option<(Vector3, Vector3, Real)> {
     if pts.len() < 3 {
         return None;
     }

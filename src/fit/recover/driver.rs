@@ -436,7 +436,7 @@ pub fn recover_shape(
                 } else {
                     budget.min(params.max_level_growth * mesh.num_vertices() as Real)
                 };
-                let next = split_within(&mesh, &h, &rank, cap)?.1.mesh;
+                let next = split_within(&mesh, &h, &[], &rank, cap)?.local.mesh;
                 if next.num_vertices() as Real > cap {
                     break (
                         false,
