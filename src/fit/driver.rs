@@ -111,30 +111,21 @@ struct WithoutCreases {
     found: usize,
 }
 
-/// The control edges of `mesh` along creases of the `data`
-/// ([`crease_edges`]), with the surface points by their midpoints found on
-/// `mesh`'s limit surface.
+/// The control edges of the control mesh of `refiner` (positions `p`)
+/// along creases of the `data` ([`crease_edges`]), with the surface points
+/// by their midpoints found by `engine`, the level's closest-point engine
+/// at `p`.
 fn detect_creases(
-    mesh: &PolyMesh,
+    refiner: &Refiner,
+    engine: &ClosestPointEngine,
+    p: &[Point3],
     data: &[Point3],
     miss: &[Real],
     data_tree: &ImmutableKdTree<Real, 3>,
     noise: Real,
     angle: Real,
-    quadtrees: &QuadtreeCache,
 ) -> Result<Vec<(u32, u32)>> {
-    let refiner = Refiner::new(mesh, &RefineOptions::default())?;
-    let engine = ClosestPointEngine::with_quadtrees(
-        &refiner,
-        &mesh.positions,
-        &ClosestPointParams {
-            tolerance: 1e-7,
-            ..Default::default()
-        },
-        quadtrees.clone(),
-    )?;
     let level = &refiner.level;
-    let p = &mesh.positions;
     let mids: Vec<Point3> = level
         .edge_verts
         .iter()
@@ -544,13 +535,14 @@ pub fn fit_screened_cloud(
             if level == 0 && params.crease_angle > 0.0 {
                 let miss: Vec<Real> = data_index.iter().map(|&i| final_dist[i]).collect();
                 let found = detect_creases(
-                    &mesh,
+                    &refiner,
+                    &engine,
+                    &mesh.positions,
                     &data,
                     &miss,
                     &data_tree,
                     data_noise,
                     params.crease_angle,
-                    &quadtrees,
                 )?;
                 if !found.is_empty() {
                     crease_pass = Some(WithoutCreases {
