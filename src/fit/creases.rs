@@ -69,26 +69,38 @@ const FLAT_EDGE_FRACTION: Real = 0.05;
 /// limb), a crease would only add a kink.
 const MISS_NOISE_MULTIPLE: Real = 2.0;
 
+/// The data a crease is judged on.
+pub(crate) struct CreaseData<'a> {
+    /// The data points.
+    pub points: &'a [Point3],
+    /// Each point's distance to the (smooth) limit surface.
+    pub miss: &'a [Real],
+    /// A tree over `points`.
+    pub tree: &'a ImmutableKdTree<Real, 3>,
+    /// The data's noise σ (0 when unknown).
+    pub noise: Real,
+}
+
 /// The control edges of `level` (positions `p`) that follow a crease of the
 /// `data` at an angle of at least `min_angle_deg` degrees, as vertex pairs
 /// `(i, j)` with `i < j`, ordered by edge. `surface[e]` is the limit-surface
-/// point closest to edge `e`'s midpoint, `tree` holds `data`, `miss[k]` is
-/// data point `k`'s distance to the (smooth) limit surface, `noise` is the
-/// data's noise σ (0 when unknown). The points by the edge must be off the
-/// smooth surface by more than the noise and on the two planes
+/// point closest to edge `e`'s midpoint. The points by the edge must be off
+/// the smooth surface by more than the noise and on the two planes
 /// ([`MISS_NOISE_MULTIPLE`]). Isolated edges (neither end on another tagged
 /// edge) are left out: a crease is a chain.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn crease_edges(
     level: &Level,
     p: &[Point3],
     surface: &[Point3],
-    data: &[Point3],
-    miss: &[Real],
-    tree: &ImmutableKdTree<Real, 3>,
-    noise: Real,
+    data: &CreaseData,
     min_angle_deg: Real,
 ) -> Vec<(u32, u32)> {
+    let CreaseData {
+        points,
+        miss,
+        tree,
+        noise,
+    } = *data;
     let cos_angle = min_angle_deg.to_radians().cos();
     let centroid = |f: u32| -> Vector3 {
         let vs = level.face_vertices(f as usize);
@@ -123,7 +135,7 @@ pub(crate) fn crease_edges(
                 if n.distance > reach2 {
                     break;
                 }
-                let q = data[n.item as usize].coords;
+                let q = points[n.item as usize].coords;
                 let s = (q - m.coords).dot(&u);
                 if s > BAND * length {
                     side_a.push(q);

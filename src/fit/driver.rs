@@ -41,7 +41,7 @@ use crate::topology::{SHARPNESS_INFINITE, face_of_corner};
 use super::init::outliers::{Screening, screen};
 use super::init::voxel_surface::taubin_smoothed_where;
 
-use super::creases::{Crease, crease_edges, refined_creases};
+use super::creases::{Crease, CreaseData, crease_edges, refined_creases};
 use super::fairness::{umbrella_matrix, vertex_rings};
 use super::levels::{Split, fitted_worse, split_within, stop_after_level};
 use super::quality::{CHECK_RATE, SelfIntersections, assess};
@@ -119,10 +119,7 @@ fn detect_creases(
     refiner: &Refiner,
     engine: &ClosestPointEngine,
     p: &[Point3],
-    data: &[Point3],
-    miss: &[Real],
-    data_tree: &ImmutableKdTree<Real, 3>,
-    noise: Real,
+    data: &CreaseData,
     angle: Real,
 ) -> Result<Vec<(u32, u32)>> {
     let level = &refiner.level;
@@ -136,9 +133,7 @@ fn detect_creases(
         .iter()
         .map(|c| c.point)
         .collect();
-    Ok(crease_edges(
-        level, p, &surface, data, miss, data_tree, noise, angle,
-    ))
+    Ok(crease_edges(level, p, &surface, data, angle))
 }
 
 /// Fits the limit surface of a control mesh, starting from `init`, to the
@@ -538,10 +533,12 @@ pub fn fit_screened_cloud(
                     &refiner,
                     &engine,
                     &mesh.positions,
-                    &data,
-                    &miss,
-                    &data_tree,
-                    data_noise,
+                    &CreaseData {
+                        points: &data,
+                        miss: &miss,
+                        tree: &data_tree,
+                        noise: data_noise,
+                    },
                     params.crease_angle,
                 )?;
                 if !found.is_empty() {
