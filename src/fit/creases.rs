@@ -24,9 +24,11 @@ use rayon::prelude::*;
 use std::collections::HashSet;
 
 use super::init::outliers::plane;
+use crate::error::Result;
+use crate::limit::ClosestPointEngine;
 use crate::math::{Point3, Real, Vector3, newell_normal};
 use crate::mesh::PolyMesh;
-use crate::subdivision::Hierarchy;
+use crate::subdivision::{Hierarchy, Refiner};
 use crate::topology::{Level, NONE, SHARPNESS_INFINITE, find_edge};
 
 /// A sharp edge `(i, j, s)`: vertices `i < j`, sharpness `s`, as
@@ -88,7 +90,7 @@ pub(crate) struct CreaseData<'a> {
 /// the smooth surface by more than the noise and on the two planes
 /// ([`MISS_NOISE_MULTIPLE`]). Isolated edges (neither end on another tagged
 /// edge) are left out: a crease is a chain.
-pub(crate) fn crease_edges(
+fn crease_edges(
     level: &Level,
     p: &[Point3],
     surface: &[Point3],
@@ -203,6 +205,31 @@ pub(crate) fn crease_edges(
         .filter(|[a, b]| ends[*a as usize] > 1 || ends[*b as usize] > 1)
         .map(|[a, b]| (a.min(b), a.max(b)))
         .collect()
+}
+
+/// The control edges of the control mesh of `refiner` (positions `p`)
+/// along creases of the `data` ([`crease_edges`]), with the surface points
+/// by their midpoints found by `engine`, the level's closest-point engine
+/// at `p`.
+pub(crate) fn detect_creases(
+    refiner: &Refiner,
+    engine: &ClosestPointEngine,
+    p: &[Point3],
+    data: &CreaseData,
+    angle: Real,
+) -> Result<Vec<(u32, u32)>> {
+    let level = &refiner.level;
+    let mids: Vec<Point3> = level
+        .edge_verts
+        .iter()
+        .map(|&[a, b]| Point3::from((p[a as usize].coords + p[b as usize].coords) / 2.0))
+        .collect();
+    let surface: Vec<Point3> = engine
+        .closest_points(&mids)?
+        .iter()
+        .map(|c| c.point)
+        .collect();
+    Ok(crease_edges(level, p, &surface, data, angle))
 }
 
 /// The infinitely sharp creases of `child`, a refinement of a control mesh

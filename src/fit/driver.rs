@@ -41,7 +41,7 @@ use crate::topology::{SHARPNESS_INFINITE, face_of_corner};
 use super::init::outliers::{Screening, screen};
 use super::init::voxel_surface::taubin_smoothed_where;
 
-use super::creases::{Crease, CreaseData, crease_edges, refined_creases};
+use super::creases::{Crease, CreaseData, detect_creases, refined_creases};
 use super::fairness::{umbrella_matrix, vertex_rings};
 use super::levels::{Split, fitted_worse, split_within, stop_after_level};
 use super::quality::{CHECK_RATE, SelfIntersections, assess};
@@ -109,31 +109,6 @@ struct WithoutCreases {
     dist: Vec<Real>,
     report: LevelReport,
     found: usize,
-}
-
-/// The control edges of the control mesh of `refiner` (positions `p`)
-/// along creases of the `data` ([`crease_edges`]), with the surface points
-/// by their midpoints found by `engine`, the level's closest-point engine
-/// at `p`.
-fn detect_creases(
-    refiner: &Refiner,
-    engine: &ClosestPointEngine,
-    p: &[Point3],
-    data: &CreaseData,
-    angle: Real,
-) -> Result<Vec<(u32, u32)>> {
-    let level = &refiner.level;
-    let mids: Vec<Point3> = level
-        .edge_verts
-        .iter()
-        .map(|&[a, b]| Point3::from((p[a as usize].coords + p[b as usize].coords) / 2.0))
-        .collect();
-    let surface: Vec<Point3> = engine
-        .closest_points(&mids)?
-        .iter()
-        .map(|c| c.point)
-        .collect();
-    Ok(crease_edges(level, p, &surface, data, angle))
 }
 
 /// Fits the limit surface of a control mesh, starting from `init`, to the
