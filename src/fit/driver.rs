@@ -492,12 +492,18 @@ pub fn fit_screened_cloud(
                 final_hints.clone_from(&last_hints);
                 (with.clone(), "tagged")
             };
+            // Both fits' work counts.
             levels.push(LevelReport {
                 level: without.report.level,
                 refinement: format!(
                     "{}; {} crease edges {note} (95th percentile {:.3} % with, {:.3} % without)",
                     without.report.refinement, without.found, e.p95_pct, before.p95_pct
                 ),
+                steps: with.steps + without.report.steps,
+                cg_iterations: with.cg_iterations + without.report.cg_iterations,
+                seconds: with.seconds + without.report.seconds,
+                setup_seconds: with.setup_seconds + without.report.setup_seconds,
+                error_seconds: with.error_seconds + without.report.error_seconds,
                 ..kept
             });
         } else {
@@ -537,6 +543,9 @@ pub fn fit_screened_cloud(
                 }
             }
         }
+        // The kept fit's error (the level without creases, should they
+        // have been dropped).
+        let error = levels[levels.len() - 1].error;
         let stat = params.tolerance_stat;
         let noise_pct = 100.0 * data_noise / diameter;
         let met = if error.pct(stat) <= params.tolerance_pct {
