@@ -4,8 +4,8 @@
 //! cannot do otherwise; a Catmull-Clark surface can keep it, with the edges
 //! of its control mesh along the crease tagged infinitely sharp (DeRose,
 //! Kass and Truong 1998; the idea of fitting piecewise smooth surfaces with
-//! tagged creases is Hoppe et al. 1994's). After the last level, every
-//! interior control edge is tested against the data around it
+//! tagged creases is Hoppe et al. 1994's). After level 0, every interior
+//! control edge is tested against the data around it
 //! ([`crease_edges`]): the points near the surface beside the edge are split
 //! by the side of the edge they lie on, a plane is fitted to each side, and
 //! the edge is a crease when both sides are flat, their planes meet at
@@ -13,15 +13,15 @@
 //! the planes' line of intersection runs along the edge and close to it. An
 //! edge that does not follow a crease of the data (the crease crosses its
 //! faces) is not tagged: the test never guesses where a crease runs between
-//! control edges. The driver then fits the level once more with the tags and
-//! keeps them only if that fit is not worse ([`super::levels::fitted_worse`]).
+//! control edges. The driver then fits the level once more with the tags,
+//! keeps them only if that fit is not worse ([`super::levels::fitted_worse`]),
+//! and carries them through the refinements ([`refined_creases`]).
 
+use std::collections::HashSet;
 use std::num::NonZero;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
-
-use std::collections::HashSet;
 
 use super::init::outliers::plane;
 use crate::error::Result;
