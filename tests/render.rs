@@ -851,3 +851,66 @@ fn cli_draws_a_lattice_as_a_cage_with_numbered_control_points() {
     assert!(err.contains("--limit is for meshes"), "{err}");
     assert!(!d.join("x.png").exists());
 }
+
+/// `--cage` draws a control mesh's sharp edges (its OBJ `t crease` tags, or
+/// a `--creases` file) in red, over the limit surface or the mesh itself;
+/// without tags there is no red.
+#[test]
+fn the_cage_shows_sharp_edges_in_red() {
+    let dir = cube_dir();
+    let cube = unit_cube();
+    // The four edges round the face z = 1 (and through the file: the top
+    // face's loop of vertices).
+    let top: Vec<u32> = (0..cube.num_vertices() as u32)
+        .filter(|&v| cube.positions[v as usize].z > 0.5)
+        .collect();
+    let face = cube
+        .faces()
+        .find(|f| f.iter().all(|v| top.contains(v)))
+        .unwrap()
+        .to_vec();
+    let creases: Vec<(u32, u32, Real)> = (0..4)
+        .map(|k| {
+            (
+                face[k].min(face[(k + 1) % 4]),
+                face[k].max(face[(k + 1) % 4]),
+                10.0,
+            )
+        })
+        .collect();
+    subdyn::io::write_mesh_with_creases(dir.path().join("tagged.obj"), &cube, None, &creases)
+        .unwrap();
+    let tags = subdyn::io::SubdivisionTags {
+        creases,
+        ..Default::default()
+    };
+    subdyn::io::write_tags(dir.path().join("top.creases"), &tags).unwrap();
+    let red = |name: &str| -> usize {
+        let picture = image::open(dir.path().join(name)).unwrap().to_rgb8();
+        picture
+            .pixels()
+            .filter(|p| p.0 == subdyn::render::SHARP_EDGES)
+            .count()
+    };
+    for (input, extra, out) in [
+        ("tagged.obj", &[][..], "tagged.png"),
+        ("tagged.obj", &["--limit", "4"][..], "tagged_limit.png"),
+        ("cube.obj", &["--creases", "top.creases"][..], "file.png"),
+        ("cube.obj", &[][..], "plain.png"),
+    ] {
+        let mut args = vec![
+            "render", input, "--cage", "--view", "30,40", "-o", out, "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        let run = subdyn(dir.path(), &args);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    }
+    assert!(red("tagged.png") > 200, "{} red pixels", red("tagged.png"));
+    assert!(red("tagged_limit.png") > 200);
+    assert!(red("file.png") > 200);
+    assert_eq!(red("plain.png"), 0);
+}

@@ -118,6 +118,15 @@ if wanted finetune_closed_curve.png; then
     done_picture finetune_closed_curve.png
 fi
 
+if wanted fit_plate_creases.png; then
+    data_gen scan plate -o "$tmp/plate.ply" --noise 0.001 --views 8 --resolution 128,96 --seed 1
+    subdyn fit "$tmp/plate.ply" -o "$tmp/plate_fit.obj" --quiet
+    subdyn render "$tmp/plate_fit.obj" --limit 4 --cage -o $images/fit_plate_creases.png \
+        --view 35,35 --size 800,600 --ssaa \
+        --title "plate scan: fitted cage, creases found in the scan in red" --quiet
+    done_picture fit_plate_creases.png
+fi
+
 if wanted fit_bun045.png && needs_shared fit_bun045.png; then
     subdyn fit "$shared/scans/bun045.ply" --init auto -o "$tmp/bun_fit.obj" \
         --report "$tmp/bun_rep.json" --plot "$tmp/bun_plot.png" --quiet

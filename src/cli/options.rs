@@ -85,7 +85,23 @@ impl RefineArgs {
     /// name the mesh or the tag file.
     pub fn refiner(&self, mesh: &PolyMesh, mesh_path: &Path) -> anyhow::Result<Refiner> {
         let mesh_name = mesh_path.display().to_string();
-        let name = mesh_name.to_ascii_lowercase();
+        let options = self.options(mesh_path)?;
+        Refiner::new(mesh, &options).map_err(|e| match (&self.creases, &e) {
+            (Some(path), subdyn::Error::Input(msg))
+                if ["crease", "vertex sharpness", "hole"]
+                    .iter()
+                    .any(|p| msg.starts_with(p)) =>
+            {
+                anyhow::anyhow!("{}: {msg} (the mesh is {mesh_name})", path.display())
+            }
+            _ => anyhow::Error::new(e).context(mesh_name),
+        })
+    }
+
+    /// The refinement options: the OBJ tags of `mesh_path` (for an `.obj` or
+    /// `.obj.gz`), the tag file's, then the flags.
+    pub fn options(&self, mesh_path: &Path) -> anyhow::Result<RefineOptions> {
+        let name = mesh_path.display().to_string().to_ascii_lowercase();
         let mut options = RefineOptions::default();
         if name.ends_with(".obj") || name.ends_with(".obj.gz") {
             let tags = read_obj_tags(mesh_path).map_err(|e| about_file(e, mesh_path))?;
@@ -111,16 +127,7 @@ impl RefineArgs {
                 TriangleRuleArg::Smooth => TriangleRule::Smooth,
             };
         }
-        Refiner::new(mesh, &options).map_err(|e| match (&self.creases, &e) {
-            (Some(path), subdyn::Error::Input(msg))
-                if ["crease", "vertex sharpness", "hole"]
-                    .iter()
-                    .any(|p| msg.starts_with(p)) =>
-            {
-                anyhow::anyhow!("{}: {msg} (the mesh is {mesh_name})", path.display())
-            }
-            _ => anyhow::Error::new(e).context(mesh_name),
-        })
+        Ok(options)
     }
 }
 

@@ -74,7 +74,9 @@ pub struct RenderArgs {
     /// Draw the limit surface of IN instead of IN itself, each quad as a K×K grid of limit samples.
     #[arg(long, value_name = "K")]
     pub limit: Option<usize>,
-    /// Overlay IN's edges (the control cage when --limit is given).
+    /// Overlay IN's edges (the control cage when --limit is given), its
+    /// sharp edges (an OBJ's `t crease` tags, --creases) in red and twice
+    /// as wide.
     #[arg(long)]
     pub cage: bool,
     /// Number IN's vertices in the picture (a lattice's control points: the
@@ -196,6 +198,18 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             );
         }
     }
+    // The cage's sharp edges (OBJ `t crease` tags, --creases), in red.
+    let sharp: Vec<(u32, u32)> = if args.cage && !as_points {
+        args.refine
+            .options(&args.input)?
+            .creases
+            .iter()
+            .filter(|c| c.2 > 0.0)
+            .map(|c| (c.0, c.1))
+            .collect()
+    } else {
+        Vec::new()
+    };
     let mut scene = Scene::default();
     if let Some(m) = surface {
         let mut layer = MeshLayer::new(m);
@@ -203,11 +217,15 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         layer.scalars = distance.as_deref();
         if args.cage && limit.is_none() {
             layer.edges = Some(EDGES);
+            layer.sharp = &sharp;
         }
         scene.meshes.push(layer);
     }
     if args.cage && limit.is_some() {
-        scene.meshes.push(MeshLayer::wireframe(&mesh, EDGES));
+        scene.meshes.push(MeshLayer {
+            sharp: &sharp,
+            ..MeshLayer::wireframe(&mesh, EDGES)
+        });
     }
     for (c, scalars) in [(&cloud, distance.as_deref()), (&extra, None)] {
         if let Some(c) = c {

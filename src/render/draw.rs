@@ -5,6 +5,7 @@ use std::collections::HashSet;
 
 use crate::error::{Error, Result};
 use crate::math::{Point3, Real, Vector3, bbox_diagonal, bounding_box};
+use crate::mesh::PolyMesh;
 
 use super::camera::{Camera, ScreenPoint};
 use super::colormap::normalise;
@@ -14,7 +15,7 @@ use super::legend::{Legend, draw_title, title_height};
 use super::marks::{draw_disk, draw_line};
 use super::picture::{Picture, Rgb};
 use super::raster::{Target, fill_triangle};
-use super::scene::{CloudLayer, MeshLayer, RenderOptions, Scene, validate_scene};
+use super::scene::{CloudLayer, MeshLayer, RenderOptions, SHARP_EDGES, Scene, validate_scene};
 use super::shading::{Headlight, corner_normals, lit};
 
 /// Depth tolerance of edge overlays, as a fraction of the scene's bounding-box
@@ -115,8 +116,24 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Picture> {
     }
     for layer in &scene.meshes {
         if let Some(color) = layer.edges {
-            context.draw_edges(&mut target, layer, color, k as usize, EDGE_BIAS * diag);
+            let all = edge_list(layer.mesh);
+            context.draw_edges(
+                &mut target,
+                layer,
+                &all,
+                color,
+                k as usize,
+                EDGE_BIAS * diag,
+            );
         }
+        context.draw_edges(
+            &mut target,
+            layer,
+            layer.sharp,
+            SHARP_EDGES,
+            2 * k as usize,
+            EDGE_BIAS * diag,
+        );
     }
 
     let mut picture = downsample(&target, k)?;
@@ -250,41 +267,39 @@ impl Context<'_> {
         }
     }
 
-    /// Every edge once, `width` working pixels wide.
+    /// The `edges` of the layer's mesh, `width` working pixels wide.
     fn draw_edges(
         &self,
         target: &mut Target,
         layer: &MeshLayer,
+        edges: &[(u32, u32)],
         color: Rgb,
         width: usize,
         bias: Real,
     ) {
-        let mesh = layer.mesh;
-        let screen: Vec<ScreenPoint> = mesh
-            .positions
-            .iter()
-            .map(|p| self.camera.project(p))
-            .collect();
+        let project = |v: u32| self.camera.project(&layer.mesh.positions[v as usize]);
         let color = to_unit(color);
-        let mut seen = HashSet::new();
-        for face in mesh.faces() {
-            for (i, &a) in face.iter().enumerate() {
-                let b = face[(i + 1) % face.len()];
-                if seen.insert((a.min(b), a.max(b))) {
-                    let (p, q) = (screen[a as usize], screen[b as usize]);
-                    draw_line(
-                        target,
-                        p,
-                        q,
-                        width,
-                        bias,
-                        self.camera.is_perspective(),
-                        color,
-                    );
-                }
-            }
+        for &(a, b) in edges {
+            draw_line(
+                target,
+                project(a),
+                project(b),
+                width,
+                bias,
+                self.camera.is_perspective(),
+                color,
+            );
         }
     }
+}
+
+/// Every edge of `mesh` once, in the order the faces meet them.
+fn edge_list(mesh: &PolyMesh) -> Vec<(u32, u32)> {
+    let mut seen = HashSet::new();
+    mesh.faces()
+        .flat_map(|face| (0..face.len()).map(move |i| (face[i], face[(i + 1) % face.len()])))
+        .filter(|&(a, b)| seen.insert((a.min(b), a.max(b))))
+        .collect()
 }
 
 /// An 8-bit colour as sRGB in `[0, 1]`.

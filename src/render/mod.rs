@@ -48,7 +48,7 @@ pub use picture::{MAX_SIDE, Picture, Rgb, check_png_path, write_png};
 pub use plot::{HLine, PlotOptions, Series, line_plot, series_color};
 pub use scene::{
     BACK, CloudLayer, EDGES, LABELS, Label, MAX_WORK_PIXELS, MeshLayer, POINTS, RenderOptions,
-    SURFACE, Scene,
+    SHARP_EDGES, SURFACE, Scene,
 };
 pub use shading::{AMBIENT, corner_normals, face_normals};
 pub use slices::slice_overlay;

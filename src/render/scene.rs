@@ -18,6 +18,8 @@ pub const BACK: Rgb = [222, 160, 120];
 pub const POINTS: Rgb = [90, 135, 205];
 /// Default colour of edge overlays.
 pub const EDGES: Rgb = [25, 25, 35];
+/// Colour of sharp edges (creases) over a cage.
+pub const SHARP_EDGES: Rgb = [215, 30, 30];
 
 /// A polygon mesh to draw: its faces (shaded), its edges, or both.
 ///
@@ -45,6 +47,9 @@ pub struct MeshLayer<'a> {
     pub faces: bool,
     /// Draw the edges on top in this colour.
     pub edges: Option<Rgb>,
+    /// Sharp edges `(i, j)` of the mesh, drawn over the edges twice as wide
+    /// in [`SHARP_EDGES`] (a control cage's creases).
+    pub sharp: &'a [(u32, u32)],
 }
 
 impl<'a> MeshLayer<'a> {
@@ -58,6 +63,7 @@ impl<'a> MeshLayer<'a> {
             back_color: BACK,
             faces: true,
             edges: None,
+            sharp: &[],
         }
     }
 
@@ -268,6 +274,15 @@ pub(crate) fn validate_scene(scene: &Scene) -> Result<()> {
         check_len("mesh", i, "normals", m.normals.map(<[_]>::len), n)?;
         check_len("mesh", i, "scalars", m.scalars.map(<[_]>::len), n)?;
         m.mesh.validate()?;
+        if let Some(&(a, b)) = m
+            .sharp
+            .iter()
+            .find(|&&(a, b)| a as usize >= n || b as usize >= n)
+        {
+            return Err(Error::Input(format!(
+                "mesh {i}: sharp edge {a} {b} names a vertex beyond its {n}"
+            )));
+        }
     }
     for (i, c) in scene.clouds.iter().enumerate() {
         check_len(
