@@ -634,3 +634,34 @@ fn the_sharp_edges_of_a_block_are_tagged_as_creases() {
         round.creases.len()
     );
 }
+
+/// An open scan's boundary is not a crease: the refiner marks boundary
+/// edges infinitely sharp, and carrying creases through the levels must
+/// not take them for creases found in the data (a smooth open patch fitted
+/// over several levels has none).
+#[test]
+fn an_open_scan_has_no_creases_on_its_boundary() {
+    use subdyn::fit::init::{InitKind, InitParams};
+    use subdyn::fit::{FitStart, fit_from_start};
+    let mut rng = Rng(11);
+    let pts: Vec<Point3> = (0..8000)
+        .map(|_| {
+            let (x, y) = (2.0 * rng.uniform() - 1.0, 2.0 * rng.uniform() - 1.0);
+            Point3::new(x, y, 0.3 * (x * x - y * y) + 0.001 * rng.gauss())
+        })
+        .collect();
+    let cloud = PointCloud::new(pts, None).unwrap();
+    let start = FitStart::Method(InitParams {
+        kind: InitKind::Open,
+        ..Default::default()
+    });
+    let params = FitParams {
+        tolerance_pct: 0.01,
+        ..Default::default()
+    };
+    let fit = fit_from_start(&cloud, &start, &params, &mut |_, _, _| {})
+        .unwrap()
+        .result;
+    assert!(fit.report.levels.len() > 1, "the fit refines");
+    assert!(fit.creases.is_empty(), "{} creases", fit.creases.len());
+}

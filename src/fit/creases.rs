@@ -246,9 +246,12 @@ pub(crate) fn refined_creases(
     parent: &[Crease],
 ) -> Vec<Crease> {
     let (level, sharp) = (&h.levels[1], &h.sharpness[1]);
+    // (The refiner marks boundary edges infinitely sharp too: not creases.)
+    let is_crease =
+        |e: usize| sharp.edge[e] >= SHARPNESS_INFINITE && level.edge_faces[e][1] != NONE;
     let Some(uniform_vertex) = uniform_vertex else {
         return (0..level.num_edges())
-            .filter(|&e| sharp.edge[e] >= SHARPNESS_INFINITE)
+            .filter(|&e| is_crease(e))
             .map(|e| {
                 let [a, b] = level.edge_verts[e];
                 (a.min(b), a.max(b), sharp.edge[e])
@@ -271,8 +274,7 @@ pub(crate) fn refined_creases(
                 continue;
             }
             let (ua, ub) = (uniform_vertex[a as usize], uniform_vertex[b as usize]);
-            let half =
-                find_edge(level, ua, ub).is_some_and(|e| sharp.edge[e] >= SHARPNESS_INFINITE);
+            let half = find_edge(level, ua, ub).is_some_and(is_crease);
             let kept = key.1 < num_parent && whole.contains(&key);
             if half || kept {
                 out.push((key.0, key.1, SHARPNESS_INFINITE));
