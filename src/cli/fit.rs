@@ -108,11 +108,12 @@ pub struct FitArgs {
     /// the crossings get fewer (0 turns it off).
     #[arg(long, value_name = "N", default_value_t = FitParams::default().final_untangle_rounds)]
     pub final_untangle_rounds: usize,
-    /// Sharp creases: after the last level, control edges along which the
-    /// scan's two sides are flat and meet at this angle or more (degrees)
-    /// are tagged infinitely sharp and kept if the refit is not worse. An
-    /// OBJ output carries them as `t crease` lines; other formats get
-    /// OUTPUT.creases beside them (0 turns creases off).
+    /// Sharp creases: after level 0, control edges along which the scan's
+    /// two sides are flat and meet at this angle or more (degrees) are
+    /// tagged infinitely sharp, kept if level 0 then fits no worse, and
+    /// carried to the finer levels. An OBJ output carries them as `t
+    /// crease` lines; other formats get OUTPUT.creases beside them (0 turns
+    /// creases off).
     #[arg(long, value_name = "DEG", default_value_t = FitParams::default().crease_angle)]
     pub crease_angle: f64,
     /// Resolution of the automatic initial model: voxels along the longest

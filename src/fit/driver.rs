@@ -102,8 +102,7 @@ pub fn crease_options(creases: &[Crease]) -> RefineOptions {
     }
 }
 
-/// The last level as fitted without creases, while it is fitted again with
-/// them.
+/// Level 0 as fitted without creases, while it is fitted again with them.
 struct WithoutCreases {
     mesh: PolyMesh,
     dist: Vec<Real>,
@@ -483,6 +482,8 @@ pub fn fit_screened_cloud(
             // one level.
             let with = levels.pop().expect("the level just pushed");
             let (e, before) = (&with.error, &without.report.error);
+            // Dropped, the refinement below still ranks the faces by the
+            // creased fit's residuals (the same mesh, fitted as closely).
             let (kept, note) = if fitted_worse((e.rms, e.p95), (before.rms, before.p95)) {
                 creases.clear();
                 mesh = without.mesh;
