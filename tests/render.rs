@@ -544,6 +544,18 @@ fn subdyn(dir: &Path, args: &[&str]) -> Output {
         .expect("the subdyn binary runs")
 }
 
+/// [`subdyn`], asserting that it succeeded (the failure shows the
+/// arguments and stderr).
+fn succeeded(dir: &Path, args: &[&str]) -> Output {
+    let out = subdyn(dir, args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// A directory holding `cube.obj` (the unit cube as quads).
 fn cube_dir() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
@@ -575,16 +587,11 @@ fn assert_fails(dir: &Path, args: &[&str], needle: &str) {
 #[test]
 fn cli_writes_a_png_of_the_requested_size() {
     let dir = cube_dir();
-    let out = subdyn(
+    let out = succeeded(
         dir.path(),
         &[
             "render", "cube.obj", "-o", "cube.png", "--size", "160,120", "--view", "-30,25",
         ],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let png = image::open(dir.path().join("cube.png")).unwrap().to_rgb8();
     assert_eq!(png.dimensions(), (160, 120));
@@ -626,12 +633,7 @@ fn cli_draws_limit_surfaces_cages_points_and_distances() {
         ],
     ];
     for args in runs {
-        let out = subdyn(d, args);
-        assert!(
-            out.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        succeeded(d, args);
         let png = image::open(d.join(args[3])).unwrap().to_rgb8();
         assert_eq!(png.dimensions(), (640, 480));
     }
@@ -667,12 +669,7 @@ fn cli_clips_distance_colours_at_the_99th_percentile_unless_a_range_is_given() {
             "cube.obj",
         ];
         args.extend(extra);
-        let out = subdyn(d, &args);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let out = succeeded(d, &args);
         String::from_utf8_lossy(&out.stdout).into_owned()
     };
     let clipped = run(&[]);
@@ -826,12 +823,7 @@ fn cli_draws_a_lattice_as_a_cage_with_numbered_control_points() {
     ] {
         let mut args = vec!["render", "lat.json", "-o", png, "--size", "320,240"];
         args.extend(extra);
-        let out = subdyn(d, &args);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let out = succeeded(d, &args);
         let text = String::from_utf8_lossy(&out.stdout);
         assert!(text.contains("27 control points"), "{text}");
         assert!(
@@ -902,12 +894,7 @@ fn the_cage_shows_sharp_edges_in_red() {
             "render", input, "--cage", "--view", "30,40", "-o", out, "--quiet",
         ];
         args.extend_from_slice(extra);
-        let run = subdyn(dir.path(), &args);
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
+        succeeded(dir.path(), &args);
     }
     assert!(red("tagged.png") > 200, "{} red pixels", red("tagged.png"));
     assert!(red("tagged_limit.png") > 200);

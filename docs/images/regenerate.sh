@@ -47,6 +47,14 @@ done_picture() {
     echo "== $images/$1 regenerated"
     made+=("$1")
 }
+# example_picture NAME EXAMPLE FILE: when NAME is wanted, runs the example
+# and copies the FILE it wrote into target/examples-out/ to NAME.
+example_picture() {
+    wanted "$1" || return 0
+    "$target/release/examples/$2"
+    cp "$examples_out/$3" "$images/$1"
+    done_picture "$1"
+}
 # middle_axial DIR: the middle one of the axial slice pictures that
 # `subdyn recover --slices-png DIR` wrote (their z follows the result).
 middle_axial() {
@@ -105,18 +113,10 @@ if wanted lattice-numbered.png; then
     done_picture lattice-numbered.png
 fi
 
-if wanted ffd_spot_bump.png; then
-    # Reads ../shared/data/meshes/spot.obj, or the same Spot built into the library.
-    "$target/release/examples/23_spot_bump"
-    cp "$examples_out/spot_bump.png" $images/ffd_spot_bump.png
-    done_picture ffd_spot_bump.png
-fi
+# Reads ../shared/data/meshes/spot.obj, or the same Spot built into the library.
+example_picture ffd_spot_bump.png 23_spot_bump spot_bump.png
 
-if wanted finetune_closed_curve.png; then
-    "$target/release/examples/30_finetune_closed_curve"
-    cp "$examples_out/finetune_closed_curve.png" $images/finetune_closed_curve.png
-    done_picture finetune_closed_curve.png
-fi
+example_picture finetune_closed_curve.png 30_finetune_closed_curve finetune_closed_curve.png
 
 if wanted fit_plate_creases.png; then
     data_gen scan plate -o "$tmp/plate.ply" --noise 0.001 --views 8 --resolution 128,96 --seed 1
@@ -157,11 +157,7 @@ if wanted demo_fit_distance.png; then
     done_picture demo_fit_distance.png
 fi
 
-if wanted drag_surface.png; then
-    "$target/release/examples/04_drag_surface"
-    cp "$examples_out/drag_surface.png" $images/drag_surface.png
-    done_picture drag_surface.png
-fi
+example_picture drag_surface.png 04_drag_surface drag_surface.png
 
 if wanted fit_genus2_outlier_spike.png; then
     data_gen scan genus2 -o "$tmp/g2.ply" --views 8 --noise 0.001 --outliers 0.05 --seed 1

@@ -107,7 +107,6 @@ struct WithoutCreases {
     mesh: PolyMesh,
     dist: Vec<Real>,
     report: LevelReport,
-    found: usize,
 }
 
 /// Fits the limit surface of a control mesh, starting from `init`, to the
@@ -479,32 +478,50 @@ pub fn fit_screened_cloud(
         final_dist.clone_from(&dist);
         if let Some(without) = crease_pass.take() {
             // The level fitted again with creases: keep the better fit, as
-            // one level.
+            // one level, counting both fits' work.
             let with = levels.pop().expect("the level just pushed");
-            let (e, before) = (&with.error, &without.report.error);
+            let smooth = without.report;
+            let dropped = fitted_worse(
+                (with.error.rms, with.error.p95),
+                (smooth.error.rms, smooth.error.p95),
+            );
+            let refinement = format!(
+                "{}; {} crease edges {} (95th percentile {:.3} % with, {:.3} % without)",
+                smooth.refinement,
+                creases.len(),
+                if dropped {
+                    "tried and dropped"
+                } else {
+                    "tagged"
+                },
+                with.error.p95_pct,
+                smooth.error.p95_pct
+            );
+            let work = (
+                with.steps + smooth.steps,
+                with.cg_iterations + smooth.cg_iterations,
+                with.seconds + smooth.seconds,
+                with.setup_seconds + smooth.setup_seconds,
+                with.error_seconds + smooth.error_seconds,
+            );
             // Dropped, the refinement below still ranks the faces by the
             // creased fit's residuals (the same mesh, fitted as closely).
-            let (kept, note) = if fitted_worse((e.rms, e.p95), (before.rms, before.p95)) {
+            let kept = if dropped {
                 creases.clear();
                 mesh = without.mesh;
                 final_dist = without.dist;
-                (without.report.clone(), "tried and dropped")
+                smooth
             } else {
                 final_hints.clone_from(&last_hints);
-                (with.clone(), "tagged")
+                with
             };
-            // Both fits' work counts.
             levels.push(LevelReport {
-                level: without.report.level,
-                refinement: format!(
-                    "{}; {} crease edges {note} (95th percentile {:.3} % with, {:.3} % without)",
-                    without.report.refinement, without.found, e.p95_pct, before.p95_pct
-                ),
-                steps: with.steps + without.report.steps,
-                cg_iterations: with.cg_iterations + without.report.cg_iterations,
-                seconds: with.seconds + without.report.seconds,
-                setup_seconds: with.setup_seconds + without.report.setup_seconds,
-                error_seconds: with.error_seconds + without.report.error_seconds,
+                refinement,
+                steps: work.0,
+                cg_iterations: work.1,
+                seconds: work.2,
+                setup_seconds: work.3,
+                error_seconds: work.4,
                 ..kept
             });
         } else {
@@ -527,7 +544,6 @@ pub fn fit_screened_cloud(
                     crease_pass = Some(WithoutCreases {
                         mesh: mesh.clone(),
                         dist: final_dist.clone(),
-                        found: found.len(),
                         report: levels.pop().expect("the level just pushed"),
                     });
                     creases = found
