@@ -20,6 +20,14 @@
 //!   outside. The stricter rule for voxels holding points keeps a part
 //!   thinner than a voxel that runs through them; a voxel at the side of a
 //!   gap that catches a few noisy points of the wall is still all outside.
+//!   A voxel whose points all have its centre on the outer side of their
+//!   tangent planes (the walls of a gap it spans, nothing running through
+//!   it) and that the quarter rule puts outside is returned as a *wall*
+//!   instead: a slot or hole under two voxels wide is often bridged by such
+//!   voxels (the plate's slot, 1.75 voxels, by voxels with 1 to 6 of 27
+//!   sub-cells inside), but removing them also cuts dents into a surface,
+//!   which can open a false handle ([`super::occupancy`] builds the cage
+//!   both ways).
 //!
 //! Carving trusts the normals' orientation, so it first checks them
 //! against the flood fill: a point's normal should lead to an outside
@@ -31,7 +39,7 @@ use rayon::prelude::*;
 
 use super::normals::SignedDistance;
 use super::voxels::VoxelGrid;
-use crate::math::{Point3, Real, Vector3};
+use crate::math::{Point3, Real};
 
 /// Sub-samples per voxel axis.
 const SUB: usize = 3;
@@ -42,7 +50,30 @@ const INSIDE_FRACTION: Real = 0.25;
 /// Fraction of decided points whose normals must lead outwards.
 pub const MIN_AGREEMENT: Real = 0.9;
 
-/// What [`carve`] did.
+/// The points a voxel holds, seen from its centre.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Held {
+    /// None.
+    Empty,
+    /// All of them have the centre on the outer side of their tangent
+    /// planes: the walls of a gap the voxel spans, or of a dent.
+    Facing,
+    /// Some have it on the inner side: a part may run through the voxel.
+    Within,
+}
+
+/// What [`carve`] did, and the gap walls it left.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Carving {
+    /// What was removed.
+    pub stats: CarveStats,
+    /// Voxels the quarter rule puts outside but left because they hold
+    /// points (all with the voxel's centre on their outer side): the walls
+    /// of a gap, or of a dent (module docs).
+    pub walls: Vec<usize>,
+}
+
+/// What [`carve`] removed.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CarveStats {
     /// Fraction of the points deciding the orientation check that agreed.
@@ -57,20 +88,23 @@ pub struct CarveStats {
 /// `h` is the voxel side.
 pub fn carve(
     solid: &mut VoxelGrid,
-    points: &[Point3],
-    normals: &[Vector3],
     sd: &SignedDistance,
     h: Real,
     world: impl Fn([Real; 3]) -> Point3 + Sync,
     voxel_of: impl Fn(&Point3) -> Option<usize>,
-) -> CarveStats {
+) -> Carving {
     let outside = solid.outside();
     let is_out = |p: Point3| voxel_of(&p).is_none_or(|n| outside[n]);
-    let mut holds_points = vec![false; solid.solid.len()];
+    let mut held = vec![Held::Empty; solid.solid.len()];
     let (mut agree, mut disagree) = (0usize, 0usize);
-    for (p, n) in points.iter().zip(normals) {
+    for (p, n) in sd.oriented_points() {
         if let Some(v) = voxel_of(p) {
-            holds_points[v] = true;
+            let c = solid.coords(v).map(|x| x as Real + 0.5);
+            let outer = (world(c) - p).dot(n) > 0.0;
+            held[v] = match (held[v], outer) {
+                (Held::Empty | Held::Facing, true) => Held::Facing,
+                _ => Held::Within,
+            };
         }
         let (ahead, behind) = (is_out(p + n * (1.5 * h)), is_out(p - n * (1.5 * h)));
         match (ahead, behind) {
@@ -81,18 +115,21 @@ pub fn carve(
     }
     let agreement = agree as Real / (agree + disagree).max(1) as Real;
     if agreement < MIN_AGREEMENT {
-        return CarveStats {
-            agreement,
-            removed: 0,
+        return Carving {
+            stats: CarveStats {
+                agreement,
+                removed: 0,
+            },
+            walls: Vec::new(),
         };
     }
-    let remove: Vec<usize> = (0..solid.solid.len())
+    let verdicts: Vec<(usize, bool)> = (0..solid.solid.len())
         .into_par_iter()
         .filter(|&n| solid.solid[n])
-        .filter(|&n| {
+        .filter_map(|n| {
             let c = solid.coords(n).map(|x| x as Real);
             if !sd.between_sheets(&world([c[0] + 0.5, c[1] + 0.5, c[2] + 0.5]), 2.0 * h) {
-                return false;
+                return None;
             }
             let mut inside = 0;
             for k in 0..SUB * SUB * SUB {
@@ -101,18 +138,27 @@ pub fn carve(
                 let (d, _) = sd.at(&world([c[0] + s[0], c[1] + s[1], c[2] + s[2]]));
                 inside += usize::from(d <= 0.0);
             }
-            if holds_points[n] {
-                inside == 0
-            } else {
-                (inside as Real) < INSIDE_FRACTION * (SUB * SUB * SUB) as Real
+            let mostly_outside = (inside as Real) < INSIDE_FRACTION * (SUB * SUB * SUB) as Real;
+            match held[n] {
+                _ if inside == 0 => Some((n, true)),
+                Held::Empty if mostly_outside => Some((n, true)),
+                Held::Facing if mostly_outside => Some((n, false)),
+                _ => None,
             }
         })
         .collect();
-    for &n in &remove {
-        solid.solid[n] = false;
+    let mut removed = 0;
+    let mut walls = Vec::new();
+    for (n, outside) in verdicts {
+        if outside {
+            solid.solid[n] = false;
+            removed += 1;
+        } else {
+            walls.push(n);
+        }
     }
-    CarveStats {
-        agreement,
-        removed: remove.len(),
+    Carving {
+        stats: CarveStats { agreement, removed },
+        walls,
     }
 }

@@ -211,7 +211,9 @@ fn occupancy(occ: OccupancyCage, why: String) -> Result<(PolyMesh, InitReport)> 
         occ.dropped_components,
         occ.repair.repairs + occ.repair.cavities
     );
-    Ok(report(occ.mesh, InitKind::Occupancy, reason, topo))
+    let (mesh, mut report) = report(occ.mesh, InitKind::Occupancy, reason, topo);
+    report.opened = occ.opened;
+    Ok((mesh, report))
 }
 
 /// Validates the cage and returns its genus; `closed` requires no boundary.
@@ -234,6 +236,7 @@ fn report(mesh: PolyMesh, chosen: InitKind, reason: String, genus: i64) -> (Poly
         vertices: mesh.num_vertices(),
         faces: mesh.num_faces(),
         screening: None,
+        opened: None,
     };
     (mesh, report)
 }

@@ -232,6 +232,11 @@ impl<'a> SignedDistance<'a> {
         )
     }
 
+    /// The points and their oriented normals.
+    pub fn oriented_points(&self) -> impl Iterator<Item = (&'a Point3, &'a Vector3)> + 'a {
+        self.points.iter().zip(self.normals)
+    }
+
     /// Whether `x` lies between two sheets of surface facing each other
     /// within `radius`: among the points whose tangent planes have `x` on
     /// their outer side, two normals at more than 120° from each other. The

@@ -36,7 +36,12 @@
 //! 3. *carve* ([`carve`]): voxels the points' oriented tangent planes
 //!    ([`oriented_normals`]) put outside, between two facing sheets, are
 //!    removed, which opens the gaps the shell bridged (legs, fingers), then
-//!    keep the largest face-connected solid (stray outliers are dropped);
+//!    keep the largest face-connected solid (stray outliers are dropped).
+//!    When removing the gap walls carving leaves ([`Carving::walls`]) too
+//!    changes the genus, that cage is returned as well
+//!    ([`OccupancyCage::opened`]): it opens a slot bridged by the voxels of
+//!    its walls, or a false handle through a dent, and only a fit tells
+//!    which;
 //! 4. [`make_manifold`]: fill voxels until the boundary is a closed 2-manifold;
 //! 5. the boundary quads between solid and empty voxels, outward, with shared
 //!    lattice corners ([`boundary_quads`]);
@@ -50,7 +55,7 @@
 //!
 //! The genus comes from `χ = V − E + F = 2c − 2g` of the closed result.
 
-use super::carve::{CarveStats, carve};
+use super::carve::{CarveStats, Carving, carve};
 use super::detect::interior_probes;
 use super::frame::PrincipalFrame;
 use super::gaps::narrow_gap;
@@ -85,6 +90,11 @@ const LEAK_LIMIT: Real = 0.25;
 pub struct OccupancyCage {
     /// Closed, outward-oriented quad mesh.
     pub mesh: PolyMesh,
+    /// The cage with the gap walls ([`Carving::walls`]) removed too, when its
+    /// genus differs from [`OccupancyCage::mesh`]'s: a slot or hole that
+    /// voxels bridged, or a dent opened into a false handle. The fit tries
+    /// both ([`crate::fit::fit_from_start`]).
+    pub opened: Option<PolyMesh>,
     /// Components, Euler characteristic and genus of [`OccupancyCage::mesh`].
     pub topology: SurfaceTopology,
     /// Grid size in voxels, margins included.
@@ -109,6 +119,15 @@ pub struct OccupancyCage {
     pub dropped_components: usize,
     /// What the manifold repair filled.
     pub repair: RepairStats,
+}
+
+/// A carved solid's cage.
+struct Carved {
+    mesh: PolyMesh,
+    topology: SurfaceTopology,
+    solid: usize,
+    dropped_components: usize,
+    repair: RepairStats,
 }
 
 /// The occupancy cage of `points` (module docs).
@@ -206,37 +225,69 @@ pub fn occupancy_cage(
         let l = frame.local(p);
         grid.index([0, 1, 2].map(|k| voxel_of(l[k], k)))
     };
-    let carved = carve(&mut solid, points, &normals, &sd, h, local, voxel_index);
-    let mut dropped_components = solid.keep_largest_component();
-    let repair = make_manifold(&mut solid);
-    dropped_components += solid.keep_largest_component();
-    if solid.count() == 0 {
-        return Err(Error::Input(
-            "the points' occupancy is empty; cannot build an occupancy cage".into(),
-        ));
-    }
-    let blocky = boundary_quads(&solid, |c| local(c.map(|x| x as Real)))?;
-    let smooth = taubin_smoothed(&blocky, smoothing_steps);
-    let mut mesh = snapped_to_points(&smooth, points, &tree, 2.0 * h)?;
-    if signed_volume(&mesh) < 0.0 {
-        mesh = reversed(&mesh)?;
-    }
-    let topology = surface_topology(&mesh)?;
-    if topology.boundary_loops != 0 {
-        return Err(Error::Topology(format!(
-            "occupancy cage has {} boundary loops; expected a closed surface",
-            topology.boundary_loops
-        )));
-    }
+    let Carving {
+        stats: carved,
+        walls,
+    } = carve(&mut solid, &sd, h, local, voxel_index);
+    let cage_of = |mut solid: VoxelGrid| -> Result<Carved> {
+        let mut dropped_components = solid.keep_largest_component();
+        let repair = make_manifold(&mut solid);
+        dropped_components += solid.keep_largest_component();
+        if solid.count() == 0 {
+            return Err(Error::Input(
+                "the points' occupancy is empty; cannot build an occupancy cage".into(),
+            ));
+        }
+        let blocky = boundary_quads(&solid, |c| local(c.map(|x| x as Real)))?;
+        let smooth = taubin_smoothed(&blocky, smoothing_steps);
+        let mut mesh = snapped_to_points(&smooth, points, &tree, 2.0 * h)?;
+        if signed_volume(&mesh) < 0.0 {
+            mesh = reversed(&mesh)?;
+        }
+        let topology = surface_topology(&mesh)?;
+        if topology.boundary_loops != 0 {
+            return Err(Error::Topology(format!(
+                "occupancy cage has {} boundary loops; expected a closed surface",
+                topology.boundary_loops
+            )));
+        }
+        Ok(Carved {
+            mesh,
+            topology,
+            solid: solid.count(),
+            dropped_components,
+            repair,
+        })
+    };
+    let opened = if walls.is_empty() {
+        None
+    } else {
+        let mut without_walls = solid.clone();
+        for &n in &walls {
+            without_walls.solid[n] = false;
+        }
+        Some(cage_of(without_walls)?)
+    };
+    let Carved {
+        mesh,
+        topology,
+        solid,
+        dropped_components,
+        repair,
+    } = cage_of(solid)?;
+    let opened = opened
+        .filter(|o| o.topology.genus != topology.genus)
+        .map(|o| o.mesh);
     Ok(OccupancyCage {
         mesh,
+        opened,
         topology,
         dims,
         voxel: h,
         gap,
         radius: r,
         occupied,
-        solid: solid.count(),
+        solid,
         closing,
         leak,
         carved,

@@ -2,6 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::math::Real;
+use crate::mesh::PolyMesh;
 
 /// Which initial control mesh to build from a point cloud.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -154,4 +155,8 @@ pub struct InitReport {
     /// thinned (the screening then covers the thinned points alone).
     #[serde(skip)]
     pub screening: Option<super::outliers::Screening>,
+    /// The occupancy cage with gap walls carved too, when its genus differs
+    /// ([`super::occupancy::OccupancyCage::opened`]).
+    #[serde(skip)]
+    pub opened: Option<PolyMesh>,
 }
