@@ -37,6 +37,7 @@ pub mod forces;
 pub mod io;
 pub mod lattice;
 pub mod limit;
+pub mod linalg;
 pub mod math;
 pub mod memory;
 pub mod mesh;

@@ -1,7 +1,6 @@
 //! A Levenberg-Marquardt step from an earlier factorisation: conjugate
-//! gradients on `A x = b` preconditioned by the Cholesky factor of an
-//! earlier `A` (Hestenes and Stiefel 1952; Saad, *Iterative Methods for
-//! Sparse Linear Systems*, 2003, Algorithm 9.1).
+//! gradients ([`crate::linalg::cg`]) on `A x = b` preconditioned by the
+//! Cholesky factor of an earlier `A`.
 //!
 //! Between Levenberg-Marquardt iterations the sparsity pattern of
 //! `A = H + λ D` is fixed and its values change little, so the previous
@@ -11,6 +10,7 @@
 //! numeric factorisation. When it does not converge within the allowed
 //! iterations the caller factors `A` afresh.
 
+use crate::linalg::{CgStop, Preconditioner, cg};
 use crate::math::Real;
 
 use super::sparse_cholesky::{Cholesky, CholeskyPattern};
@@ -33,34 +33,21 @@ pub fn preconditioned_solution(
     relative: Real,
     max_iterations: usize,
 ) -> (Option<Vec<Real>>, usize) {
-    let dot = |u: &[Real], v: &[Real]| u.iter().zip(v).map(|(a, b)| a * b).sum::<Real>();
-    let target = relative.max(RELATIVE_RESIDUAL) * dot(b, b).sqrt();
     let mut x = vec![0.0; b.len()];
-    let mut r = b.to_vec();
-    let mut z = factor.solution(&r);
-    let mut p = z.clone();
-    let mut rz = dot(&r, &z);
-    for it in 1..=max_iterations {
-        let q = pattern.product(values, &p);
-        let curvature = dot(&p, &q);
-        if curvature.is_nan() || curvature <= 0.0 || !rz.is_finite() {
-            return (None, it);
-        }
-        let step = rz / curvature;
-        for i in 0..x.len() {
-            x[i] += step * p[i];
-            r[i] -= step * q[i];
-        }
-        if dot(&r, &r).sqrt() <= target {
-            return (Some(x), it);
-        }
-        z = factor.solution(&r);
-        let rz_new = dot(&r, &z);
-        let beta = rz_new / rz;
-        rz = rz_new;
-        for i in 0..p.len() {
-            p[i] = z[i] + beta * p[i];
-        }
+    let stop = CgStop {
+        tolerance: relative.max(RELATIVE_RESIDUAL),
+        max_iterations,
+    };
+    match cg(|p| Ok(pattern.product(values, p)), factor, b, &mut x, &stop) {
+        Ok(Ok(outcome)) if outcome.converged => (Some(x), outcome.iterations[0]),
+        Ok(Ok(_)) => (None, max_iterations),
+        Ok(Err(breakdown)) => (None, breakdown.iteration + 1),
+        Err(_) => (None, 0),
     }
-    (None, max_iterations)
+}
+
+impl Preconditioner<Real> for Cholesky<'_> {
+    fn apply(&self, r: &[Real]) -> Vec<Real> {
+        self.solution(r)
+    }
 }

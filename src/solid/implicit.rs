@@ -32,6 +32,7 @@
 use std::time::Instant;
 
 use crate::error::{Error, Result};
+use crate::linalg::{CgStop, cg};
 use crate::math::{Real, Vector3};
 use crate::stencil::StencilTable;
 
@@ -39,25 +40,27 @@ use super::explicit::{StepReport, check_step};
 use super::model::{PrecondFactor, Preconditioner, Solid};
 use super::params::ImplicitPreconditioner;
 use super::products::{
-    cholesky, cholesky_dense, dot, mul_transpose_vectors, mul_vectors, solve_vectors,
+    cholesky, cholesky_dense, mul_transpose_vectors, mul_vectors, solve_vectors,
 };
 use super::reduced::{BlockPattern, MAX_DENSE_UNKNOWNS, ReducedInputs, reduced_matrix};
 use super::springs::SpringHessians;
 
 /// `z = P⁻¹ r` with a factored preconditioner.
-fn precondition(factor: &PrecondFactor, r: &[Vector3]) -> Vec<Vector3> {
-    match factor {
-        PrecondFactor::Laplacian(f) => solve_vectors(f, r),
-        PrecondFactor::Hessian(f) => {
-            let mut b = nalgebra::DVector::from_iterator(
-                3 * r.len(),
-                r.iter().flat_map(|v| [v.x, v.y, v.z]),
-            );
-            f.solve_mut(&mut b);
-            b.as_slice()
-                .chunks_exact(3)
-                .map(|c| Vector3::new(c[0], c[1], c[2]))
-                .collect()
+impl crate::linalg::Preconditioner<Vector3> for PrecondFactor {
+    fn apply(&self, r: &[Vector3]) -> Vec<Vector3> {
+        match self {
+            PrecondFactor::Laplacian(f) => solve_vectors(f, r),
+            PrecondFactor::Hessian(f) => {
+                let mut b = nalgebra::DVector::from_iterator(
+                    3 * r.len(),
+                    r.iter().flat_map(|v| [v.x, v.y, v.z]),
+                );
+                f.solve_mut(&mut b);
+                b.as_slice()
+                    .chunks_exact(3)
+                    .map(|c| Vector3::new(c[0], c[1], c[2]))
+                    .collect()
+            }
         }
     }
 }
@@ -203,52 +206,17 @@ impl Solid {
         } else {
             vec![Vector3::zeros(); n]
         };
-        let b_norm = dot(&b, &b).sqrt();
-        if b_norm == 0.0 {
-            x.iter_mut().for_each(|v| *v = Vector3::zeros());
-        }
-        let mut r: Vec<Vector3> = if x.iter().all(|v| *v == Vector3::zeros()) {
-            b.clone()
-        } else {
-            let ax = apply(&x);
-            b.iter().zip(&ax).map(|(b, a)| b - a).collect()
+        let stop = CgStop {
+            tolerance: self.params.cg_tolerance,
+            max_iterations: self.params.cg_max_iterations,
         };
-        let mut z = precondition(&pre.factor, &r);
-        let mut dir = z.clone();
-        let mut rz = dot(&r, &z);
-        let mut iterations = 0;
-        let mut residual = if b_norm > 0.0 {
-            dot(&r, &r).sqrt() / b_norm
-        } else {
-            0.0
-        };
-        let tol = self.params.cg_tolerance;
-        while residual > tol && iterations < self.params.cg_max_iterations {
-            let q = apply(&dir);
-            let dq = dot(&dir, &q);
-            if !(dq > 0.0 && dq.is_finite()) {
-                return Err(Error::NotConverged(format!(
-                    "implicit step: CG met a non-positive curvature {dq:.3e} at iteration {iterations}"
-                )));
-            }
-            let alpha = rz / dq;
-            for k in 0..n {
-                x[k] += dir[k] * alpha;
-                r[k] -= q[k] * alpha;
-            }
-            iterations += 1;
-            residual = dot(&r, &r).sqrt() / b_norm;
-            if residual <= tol {
-                break;
-            }
-            z = precondition(&pre.factor, &r);
-            let rz_new = dot(&r, &z);
-            let beta = rz_new / rz;
-            rz = rz_new;
-            for k in 0..n {
-                dir[k] = z[k] + dir[k] * beta;
-            }
-        }
+        let outcome = cg(|v| Ok(apply(v)), &pre.factor, &b, &mut x, &stop)?.map_err(|e| {
+            Error::NotConverged(format!(
+                "implicit step: conjugate gradients stopped at iteration {}: {}",
+                e.iteration, e.what
+            ))
+        })?;
+        let (iterations, residual) = (outcome.iterations[0], outcome.relative[0]);
         if let Some(p) = self.precond.as_mut() {
             p.excess += iterations.saturating_sub(1);
             p.stale = matches!(p.factor, PrecondFactor::Hessian(_))

@@ -100,8 +100,3 @@ pub fn solve_vectors(factor: &Cholesky<Real, Dyn>, r: &[Vector3]) -> Vec<Vector3
         .map(|i| Vector3::new(b[(i, 0)], b[(i, 1)], b[(i, 2)]))
         .collect()
 }
-
-/// `Σ x_i · y_i` over per-point vectors.
-pub fn dot(x: &[Vector3], y: &[Vector3]) -> Real {
-    x.iter().zip(y).map(|(a, b)| a.dot(b)).sum()
-}
