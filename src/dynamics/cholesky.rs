@@ -6,7 +6,7 @@
 //!
 //! `A` is a symmetric positive definite [`StencilTable`] over the control
 //! points (scalar entries; x, y and z share it). Its graph is ordered by
-//! nested dissection (`stencil::nested_dissection`); the symbolic
+//! nested dissection (`linalg::nested_dissection`); the symbolic
 //! phase finds the elimination tree and every row's pattern of `L` by
 //! `ereach`, the numeric phase is the up-looking algorithm (Davis, *Direct
 //! Methods for Sparse Linear Systems*, 2006, §4.1 (etree), §4.2 (`ereach`)
@@ -15,8 +15,9 @@
 //! is not positive (an indefinite or singular matrix) is an error.
 
 use crate::error::{Error, Result};
+use crate::linalg::nested_dissection;
 use crate::math::{Point3, Real, Vector3};
-use crate::stencil::{StencilTable, nested_dissection};
+use crate::stencil::StencilTable;
 
 /// No parent in the elimination tree.
 const NONE: usize = usize::MAX;

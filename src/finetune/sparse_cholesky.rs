@@ -37,7 +37,7 @@ use rayon::prelude::*;
 
 use crate::math::Real;
 
-use crate::stencil::nested_dissection;
+use crate::linalg::nested_dissection;
 
 /// Ordering, block pattern of `P A Pᵀ` (upper triangle by block columns) and
 /// symbolic factor of a sparse symmetric matrix.
