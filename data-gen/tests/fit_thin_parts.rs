@@ -74,9 +74,10 @@ fn the_chairs_cage_does_not_web_its_legs() {
 
 /// A slot or hole under two occupancy voxels wide is bridged by voxels that
 /// hold only points of its walls. The fit tries the cage with those walls
-/// carved too and keeps it when less of its level-0 surface is far from the
-/// points: the plate's slot (genus 1) and the bracket's four holes (genus 4)
-/// come out open, where the bridged cages had genus 2 and 3.
+/// carved too and keeps it when its level-0 surface near them has far less
+/// area far from the points (the web is gone): the plate's slot (genus 1)
+/// and the bracket's four holes (genus 4) come out open, where the bridged
+/// cages had genus 2 and 3.
 #[test]
 fn slots_and_holes_bridged_by_voxels_open() {
     use subdyn::fit::init::surface_topology;

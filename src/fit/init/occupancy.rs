@@ -94,7 +94,7 @@ pub struct OccupancyCage {
     /// genus differs from [`OccupancyCage::mesh`]'s: a slot or hole that
     /// voxels bridged, or a dent opened into a false handle. The fit tries
     /// both ([`crate::fit::fit_from_start`]).
-    pub opened: Option<PolyMesh>,
+    pub opened: Option<Opened>,
     /// Components, Euler characteristic and genus of [`OccupancyCage::mesh`].
     pub topology: SurfaceTopology,
     /// Grid size in voxels, margins included.
@@ -119,6 +119,19 @@ pub struct OccupancyCage {
     pub dropped_components: usize,
     /// What the manifold repair filled.
     pub repair: RepairStats,
+}
+
+/// The occupancy cage without its gap walls ([`OccupancyCage::opened`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Opened {
+    /// Closed, outward-oriented quad mesh.
+    pub mesh: PolyMesh,
+    /// Its genus.
+    pub genus: i64,
+    /// The centres of the wall voxels removed.
+    pub walls: Vec<Point3>,
+    /// The voxel side.
+    pub voxel: Real,
 }
 
 /// A carved solid's cage.
@@ -268,6 +281,10 @@ pub fn occupancy_cage(
         }
         Some(cage_of(without_walls)?)
     };
+    let wall_centres: Vec<Point3> = walls
+        .iter()
+        .map(|&n| local(solid.coords(n).map(|x| x as Real + 0.5)))
+        .collect();
     let Carved {
         mesh,
         topology,
@@ -277,7 +294,12 @@ pub fn occupancy_cage(
     } = cage_of(solid)?;
     let opened = opened
         .filter(|o| o.topology.genus != topology.genus)
-        .map(|o| o.mesh);
+        .map(|o| Opened {
+            mesh: o.mesh,
+            genus: o.topology.genus,
+            walls: wall_centres,
+            voxel: h,
+        });
     Ok(OccupancyCage {
         mesh,
         opened,

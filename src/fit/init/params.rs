@@ -2,7 +2,6 @@
 
 use crate::error::{Error, Result};
 use crate::math::Real;
-use crate::mesh::PolyMesh;
 
 /// Which initial control mesh to build from a point cloud.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
@@ -158,5 +157,5 @@ pub struct InitReport {
     /// The occupancy cage with gap walls carved too, when its genus differs
     /// ([`super::occupancy::OccupancyCage::opened`]).
     #[serde(skip)]
-    pub opened: Option<PolyMesh>,
+    pub opened: Option<super::occupancy::Opened>,
 }
