@@ -272,6 +272,7 @@ pub fn occupancy_cage(
             repair,
         })
     };
+    // A cage without the walls that cannot be built is not offered.
     let opened = if walls.is_empty() {
         None
     } else {
@@ -279,7 +280,7 @@ pub fn occupancy_cage(
         for &n in &walls {
             without_walls.solid[n] = false;
         }
-        Some(cage_of(without_walls)?)
+        cage_of(without_walls).ok()
     };
     let wall_centres: Vec<Point3> = walls
         .iter()
