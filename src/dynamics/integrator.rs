@@ -26,10 +26,10 @@
 
 use crate::error::{Error, Result};
 use crate::limit::PatchTable;
+use crate::linalg::SparseCholesky;
 use crate::math::{Point3, Real, first_non_finite};
 use crate::stencil::StencilTable;
 
-use super::cholesky::SparseCholesky;
 use super::elements::patch_matrices;
 use super::matrices::MaterialParams;
 use super::pcg::{PcgParams, pcg};

@@ -3,9 +3,8 @@
 //! matrices assembled over the control points, implicit time integration
 //! (first and second order), and two linear solvers: preconditioned
 //! conjugate gradients and, for steps that reuse their matrix, sparse
-//! Cholesky.
+//! Cholesky (`linalg`'s scalar factor, re-exported here).
 
-mod cholesky;
 mod elements;
 mod integrator;
 mod matrices;
@@ -13,7 +12,7 @@ mod pcg;
 mod quadrature;
 mod sample_rows;
 
-pub use cholesky::SparseCholesky;
+pub use crate::linalg::SparseCholesky;
 pub use elements::{
     PatchElements, parameter_area, patch_damping_matrix, patch_matrices,
     patch_stiffness_and_damping, patch_stiffness_matrix, stiffness_and_damping_elements,

@@ -39,7 +39,7 @@ use std::time::Instant;
 use crate::math::Real;
 
 use super::refined_step::preconditioned_solution;
-use super::sparse_cholesky::{CholeskyPattern, join_if};
+use crate::linalg::{CholeskyPattern, join_if};
 
 /// Problems with at least this many runs of rows assemble `H` on two threads.
 const PARALLEL_RUNS: usize = 2048;

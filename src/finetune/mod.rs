@@ -32,13 +32,13 @@ mod curve_solver;
 mod edge_loops;
 mod levenberg_marquardt;
 mod refined_step;
-mod sparse_cholesky;
 mod surface;
 mod surface_energy;
 mod surface_gauss_newton;
 mod surface_solve;
 mod surface_targets;
 
+pub use crate::linalg::{Cholesky, CholeskyPattern};
 pub use convert::{Conversion, ConvertedEdge, conversion_weight, doo_sabin_to_non_uniform};
 pub use curve::{CurveFinetune, CurveFinetuneParams, CurveFinetuneReport, finetune_curve};
 pub use curve_alpha::{ScalarFunction, ValuesOn, alpha_from_values, values_on};
@@ -55,7 +55,6 @@ pub use levenberg_marquardt::{
     Residuals, levenberg_marquardt,
 };
 pub use refined_step::{RELATIVE_RESIDUAL, preconditioned_solution};
-pub use sparse_cholesky::{Cholesky, CholeskyPattern};
 pub use surface::{SurfaceFineTune, SurfaceFineTuneParams, SurfaceFineTuneReport, SurfaceScheme};
 pub use surface_energy::{SpringEnergy, angle_and_gradients, joint_angles};
 pub use surface_targets::{LegKind, loop_targets};

@@ -13,7 +13,7 @@
 use crate::linalg::{CgStop, Preconditioner, cg};
 use crate::math::Real;
 
-use super::sparse_cholesky::{Cholesky, CholeskyPattern};
+use crate::linalg::{Cholesky, CholeskyPattern};
 
 /// The tightest convergence asked of a step: `|b − A x| ≤ RELATIVE_RESIDUAL
 /// · |b|`, `1e-10` (a direct solve of these systems leaves about `1e-13`).

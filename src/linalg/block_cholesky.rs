@@ -3,9 +3,10 @@
 //! thousand unknowns, the same pattern at every step), in 3 × 3 blocks.
 //!
 //! Up-looking algorithm (Davis, *Direct Methods for Sparse Linear Systems*,
-//! 2006, §4.2 and §4.6: elimination tree, row patterns by `ereach`) on the
-//! graph of nodes (a point's unknowns), with a nested-dissection ordering
-//! (`nested_dissection`, minimum degree on small parts). On the benchmark
+//! 2006, §4.6) on the graph of nodes (a point's unknowns); the ordering
+//! (nested dissection, minimum degree on small parts), elimination tree and
+//! row patterns (`ereach`, §4.1–4.2) come from the symbolic phase shared
+//! with the scalar factor (`linalg::symbolic`). On the benchmark
 //! torus (1,900 nodes) building the pattern took 20–37 ms with nested
 //! dissection against 85–177 ms with minimum degree on the whole graph (a
 //! loaded 2-core machine), with 105,041 factor blocks against 116,058.
@@ -37,7 +38,7 @@ use rayon::prelude::*;
 
 use crate::math::Real;
 
-use crate::linalg::nested_dissection;
+use super::symbolic::{Ordering, Symbolic};
 
 /// Ordering, block pattern of `P A Pᵀ` (upper triangle by block columns) and
 /// symbolic factor of a sparse symmetric matrix.
@@ -52,10 +53,8 @@ pub struct CholeskyPattern {
     c_start: Vec<usize>,
     /// Block row indices of `C` (each column sorted, diagonal last).
     c_rows: Vec<usize>,
-    /// Elimination tree of the blocks.
-    parent: Vec<Option<usize>>,
-    /// Block column starts of `L`.
-    l_start: Vec<usize>,
+    /// Elimination tree, row patterns and block column starts of `L`.
+    symbolic: Symbolic,
     /// `(a, b)`: columns `0 … a` (part A) and `a … b` (part B) share no
     /// row of `L`, so they are eliminated in parallel; the columns from `b`
     /// on (the separator) follow. `(nb, nb)` when the factor is serial.
@@ -124,11 +123,11 @@ impl CholeskyPattern {
             a.sort_unstable();
             a.dedup();
         }
-        let (order, top) = nested_dissection(&adj);
-        let mut rank = vec![0; nb];
-        for (r, &b) in order.iter().enumerate() {
-            rank[b] = r;
-        }
+        let Ordering {
+            perm: order,
+            rank,
+            top,
+        } = Ordering::new(&adj);
         let place: Vec<(usize, usize)> = block_of.iter().map(|&(b, k)| (rank[b], k)).collect();
         let padding = (0..nb)
             .flat_map(|b| {
@@ -207,27 +206,13 @@ impl CholeskyPattern {
             chunk_slots(groups)
         };
         slots.extend((0..n).map(|i| slot(i, i, stored(place[i].0, place[i].0))));
-        let parent = elimination_tree(nb, &c_start, &c_rows);
-        let mut counts = vec![1usize; nb];
-        let mut mark = vec![usize::MAX; nb];
-        let mut stack = Vec::new();
-        for k in 0..nb {
-            row_pattern(k, &c_start, &c_rows, &parent, &mut mark, &mut stack);
-            for &i in &stack {
-                counts[i] += 1;
-            }
-        }
-        let mut l_start = vec![0; nb + 1];
-        for k in 0..nb {
-            l_start[k + 1] = l_start[k] + counts[k];
-        }
+        let symbolic = Symbolic::new(&c_start, &c_rows);
         // A and B must share no row of L: no column of A has its parent in B.
-
         let split = top
             .filter(|_| nb >= PARALLEL_BLOCKS)
             .map(|(a, b)| (a, a + b))
             .filter(|&(a, b)| {
-                parent[..a]
+                symbolic.parent[..a]
                     .iter()
                     .all(|p| p.is_none_or(|p| !(a..b).contains(&p)))
             })
@@ -238,8 +223,7 @@ impl CholeskyPattern {
             padding,
             c_start,
             c_rows,
-            parent,
-            l_start,
+            symbolic,
             split,
         };
         (pattern, slots)
@@ -252,13 +236,13 @@ impl CholeskyPattern {
 
     /// Stored 3 × 3 blocks of the factor `L`.
     pub fn factor_blocks(&self) -> usize {
-        self.l_start[self.l_start.len() - 1]
+        self.symbolic.num_entries()
     }
 
     /// The product `A x` of the symmetric matrix whose upper triangle (in
     /// the slots returned by [`new`](Self::new)) is `values` with `x`.
     pub fn product(&self, values: &[Real], x: &[Real]) -> Vec<Real> {
-        let nb = self.l_start.len() - 1;
+        let nb = self.symbolic.num_columns();
         let mut xb = vec![Vector3::zeros(); nb];
         for (i, &(blk, k)) in self.place.iter().enumerate() {
             xb[blk][k] = x[i];
@@ -284,7 +268,7 @@ impl CholeskyPattern {
     /// two parts eliminated in parallel, before the separator.
     pub fn parallel_parts(&self) -> Option<(usize, usize)> {
         let (a, b) = self.split;
-        (a < self.l_start.len() - 1).then_some((a, b - a))
+        (a < self.symbolic.num_columns()).then_some((a, b - a))
     }
 
     /// The factor of the matrix whose upper triangle (in the slots returned by
@@ -302,7 +286,7 @@ impl CholeskyPattern {
     }
 
     fn factor_on_worker(&self, values: &[Real]) -> Option<Cholesky<'_>> {
-        let nb = self.l_start.len() - 1;
+        let nb = self.symbolic.num_columns();
         let (a_end, b_end) = self.split;
         let block = |p: usize| Matrix3::from_fn(|r, c| values[9 * p + 3 * r + c]);
         let mut pad = vec![[false; 3]; nb];
@@ -320,11 +304,12 @@ impl CholeskyPattern {
             }
             d
         };
-        let nnz = self.l_start[nb];
+        let l_start = &self.symbolic.l_start;
+        let nnz = self.symbolic.num_entries();
         let mut rows = vec![0; nnz];
         let mut blocks: Vec<Matrix3<Real>> = vec![Matrix3::zeros(); nnz];
         let mut inverse: Vec<Matrix3<Real>> = vec![Matrix3::zeros(); nb];
-        let mut next: Vec<usize> = self.l_start[..nb].to_vec();
+        let mut next: Vec<usize> = l_start[..nb].to_vec();
         let [mut a, mut b, mut sep] = self.columns(
             [a_end, b_end],
             &mut rows,
@@ -338,14 +323,12 @@ impl CholeskyPattern {
                 return Some(());
             }
             let mut x = vec![Matrix3::zeros(); nb];
-            let mut mark = vec![usize::MAX; nb];
-            let mut stack = Vec::new();
             for k in range {
-                self.row_pattern(k, &mut mark, &mut stack);
                 for p in self.c_start[k]..self.c_start[k + 1] - 1 {
                     x[self.c_rows[p]] += block(p);
                 }
-                let d = diagonal(k) - cols.eliminate(&self.l_start, k, &stack, &mut x);
+                let row = self.symbolic.row(k);
+                let d = diagonal(k) - cols.eliminate(l_start, k, row, &mut x);
                 cols.close(k, d)?;
             }
             Some(())
@@ -359,14 +342,11 @@ impl CholeskyPattern {
         done_b?;
         // Separator rows.
         let mut x = [(); 3].map(|_| vec![Matrix3::zeros(); if b_end < nb { nb } else { 0 }]);
-        let mut mark = vec![usize::MAX; nb];
-        let mut stack = Vec::new();
         let mut parts: [Vec<usize>; 3] = Default::default();
         let part_of = |i: usize| usize::from(i >= a_end) + usize::from(i >= b_end);
         for k in b_end..nb {
-            self.row_pattern(k, &mut mark, &mut stack);
             parts.iter_mut().for_each(Vec::clear);
-            for &i in &stack {
+            for &i in self.symbolic.row(k) {
                 parts[part_of(i)].push(i);
             }
             for p in self.c_start[k]..self.c_start[k + 1] - 1 {
@@ -375,15 +355,15 @@ impl CholeskyPattern {
             }
             let [xa, xb, xs] = &mut x;
             let (da, db) = rayon::join(
-                || a.eliminate(&self.l_start, k, &parts[0], xa),
-                || b.eliminate(&self.l_start, k, &parts[1], xb),
+                || a.eliminate(l_start, k, &parts[0], xa),
+                || b.eliminate(l_start, k, &parts[1], xb),
             );
             for r in b_end..k {
                 xs[r] += xa[r] + xb[r];
                 xa[r] = Matrix3::zeros();
                 xb[r] = Matrix3::zeros();
             }
-            let ds = sep.eliminate(&self.l_start, k, &parts[2], xs);
+            let ds = sep.eliminate(l_start, k, &parts[2], xs);
             sep.close(k, diagonal(k) - da - db - ds)?;
         }
         Some(Cholesky {
@@ -404,7 +384,7 @@ impl CholeskyPattern {
         next: &'s mut [usize],
     ) -> [Columns<'s>; 3] {
         let [a, b] = cuts;
-        let (la, lb) = (self.l_start[a], self.l_start[b]);
+        let (la, lb) = (self.symbolic.l_start[a], self.symbolic.l_start[b]);
         let mut rows = cut(rows, la, lb).into_iter();
         let mut blocks = cut(blocks, la, lb).into_iter();
         let mut inverse = cut(inverse, a, b).into_iter();
@@ -417,11 +397,6 @@ impl CholeskyPattern {
             inverse: inverse.next().expect("three parts"),
             next: next.next().expect("three parts"),
         })
-    }
-
-    /// [`row_pattern`] of row `k` of this pattern's factor.
-    fn row_pattern(&self, k: usize, mark: &mut [usize], stack: &mut Vec<usize>) {
-        row_pattern(k, &self.c_start, &self.c_rows, &self.parent, mark, stack);
     }
 }
 
@@ -496,7 +471,7 @@ impl Cholesky<'_> {
 
     fn solution_on_worker(&self, b: &[Real]) -> Vec<Real> {
         let p = self.pattern;
-        let nb = p.l_start.len() - 1;
+        let nb = p.symbolic.num_columns();
         let (a_end, b_end) = p.split;
         let mut x: Vec<Vector3<Real>> = vec![Vector3::zeros(); nb];
         for (i, &(blk, k)) in p.place.iter().enumerate() {
@@ -528,7 +503,7 @@ impl Cholesky<'_> {
     /// of rows from `sep` on go to the returned accumulator (indexed from
     /// `sep`).
     fn forward(&self, first: usize, x: &mut [Vector3<Real>], sep: usize) -> Vec<Vector3<Real>> {
-        let l_start = &self.pattern.l_start;
+        let l_start = &self.pattern.symbolic.l_start;
         let mut out = vec![Vector3::zeros(); l_start.len() - 1 - sep];
         for c in 0..x.len() {
             let j = first + c;
@@ -549,7 +524,7 @@ impl Cholesky<'_> {
     /// Backward substitution over the columns `first …` held in `x`; rows
     /// beyond them are read from `sep` (the separator's solved values).
     fn backward(&self, first: usize, x: &mut [Vector3<Real>], sep: &[Vector3<Real>]) {
-        let l_start = &self.pattern.l_start;
+        let l_start = &self.pattern.symbolic.l_start;
         let end = first + x.len();
         let sep_first = self.pattern.split.1;
         for c in (0..x.len()).rev() {
@@ -583,7 +558,7 @@ fn in_pool_if<R: Send>(parallel: bool, f: impl FnOnce() -> R + Send) -> R {
 
 /// `(a(), b())`, on two threads (`rayon::join`) if `parallel`, else in turn
 /// on this one (a join from outside rayon's pool costs a hand-over to it).
-pub(super) fn join_if<A: Send, B: Send>(
+pub(crate) fn join_if<A: Send, B: Send>(
     parallel: bool,
     a: impl FnOnce() -> A + Send,
     b: impl FnOnce() -> B + Send,
@@ -593,56 +568,4 @@ pub(super) fn join_if<A: Send, B: Send>(
     } else {
         (a(), b())
     }
-}
-
-/// Elimination tree of a matrix given by its upper triangle by columns
-/// (Davis 2006, §4.1, with path compression).
-fn elimination_tree(n: usize, start: &[usize], rows: &[usize]) -> Vec<Option<usize>> {
-    let mut parent = vec![None; n];
-    let mut ancestor: Vec<Option<usize>> = vec![None; n];
-    for k in 0..n {
-        for &row in &rows[start[k]..start[k + 1]] {
-            let mut i = Some(row);
-            while let Some(j) = i.filter(|&j| j < k) {
-                let next = ancestor[j];
-                ancestor[j] = Some(k);
-                if next.is_none() {
-                    parent[j] = Some(k);
-                }
-                i = next;
-            }
-        }
-    }
-    parent
-}
-
-/// The pattern of row `k` of `L` (columns `< k`) in topological order, into
-/// `stack` (Davis 2006, §4.2 `ereach`). `mark` holds `k` for visited nodes.
-fn row_pattern(
-    k: usize,
-    start: &[usize],
-    rows: &[usize],
-    parent: &[Option<usize>],
-    mark: &mut [usize],
-    stack: &mut Vec<usize>,
-) {
-    stack.clear();
-    mark[k] = k;
-    let mut path = Vec::new();
-    for &row in &rows[start[k]..start[k + 1]] {
-        let mut i = row;
-        path.clear();
-        while mark[i] != k {
-            path.push(i);
-            mark[i] = k;
-            match parent[i] {
-                Some(p) => i = p,
-                None => break,
-            }
-        }
-        // Each path ancestor-first; the final reversal lists later paths
-        // (which end below earlier ones) first, each child-first.
-        stack.extend(path.iter().rev());
-    }
-    stack.reverse();
 }
