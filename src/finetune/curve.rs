@@ -39,6 +39,7 @@ use argmin::solver::linesearch::MoreThuenteLineSearch;
 use nalgebra::DVector;
 
 use crate::error::{Error, Result};
+use crate::linalg::{LeastSquares, LmParams, levenberg_marquardt};
 use crate::math::{Point3, Real, Vector3, bounding_box, first_non_finite};
 use crate::subdivision::CurveTopology;
 
@@ -49,7 +50,7 @@ use super::curve_exact::{ExactFinetune, closed_spline, exact_finetune};
 use super::curve_frames::leg_frames;
 use super::curve_gauss_newton::CurvePointProblem;
 use super::curve_solver::{Converging, History, STALLED, SpringProblem};
-use super::levenberg_marquardt::{FinetuneMethod, LeastSquares, LmParams, levenberg_marquardt};
+use super::method::FinetuneMethod;
 
 /// Parameters of closed-curve fine tuning.
 #[derive(Clone, Debug, PartialEq)]

@@ -17,12 +17,12 @@
 //! `curve_energy`, so that `Σ r² = E` of eq. 13; for a 3-D curve each joint
 //! also gets the zero-valued curvature rows of `angle_curvature`.
 
+use crate::linalg::{LeastSquares, Residuals};
 use crate::math::{Point3, Real, Vector3};
 
 use super::angle_curvature::transverse_rows;
 use super::curve_energy::{SpringTargets, joint_angle, joint_angle_gradients, wrap_angle};
 use super::curve_solver::SpringProblem;
-use super::levenberg_marquardt::{LeastSquares, Residuals};
 
 /// Energy (13) over point displacements, with the gauge of a [`SpringProblem`].
 #[derive(Clone, Debug)]

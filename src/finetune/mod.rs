@@ -3,8 +3,9 @@
 //!
 //! Curves: a new curve `Q` with `Q'(t) = α(t) P'(t)`, closed curves closed
 //! again by the spring energy (13) minimised by Levenberg-Marquardt
-//! (`levenberg_marquardt`, `sparse_cholesky` with the stencil module's
-//! nested-dissection ordering, `angle_curvature`) or argmin's nonlinear CG. Files:
+//! (`linalg::levenberg_marquardt` on `linalg`'s 3 × 3-block sparse Cholesky,
+//! re-exported here; `angle_curvature`) or argmin's nonlinear CG
+//! (`method`: which of the two). Files:
 //! `curve_alpha` (α from control values), `curve_exact` (exact product and
 //! integral as a B-spline), `curve_bspline` (evaluation), `curve_energy`
 //! (eq. 13), `curve_frames` (fixed point and rotation), `curve_solver` (argmin
@@ -30,15 +31,18 @@ mod curve_io;
 mod curve_picture;
 mod curve_solver;
 mod edge_loops;
-mod levenberg_marquardt;
-mod refined_step;
+mod method;
 mod surface;
 mod surface_energy;
 mod surface_gauss_newton;
 mod surface_solve;
 mod surface_targets;
 
-pub use crate::linalg::{Cholesky, CholeskyPattern};
+pub use crate::linalg::{
+    Cholesky, CholeskyPattern, FORCING_MAX, LeastSquares, LmParams, LmRun, LmTimings,
+    REFINEMENT_ITERATIONS, RELATIVE_RESIDUAL, Residuals, levenberg_marquardt,
+    preconditioned_solution,
+};
 pub use convert::{Conversion, ConvertedEdge, conversion_weight, doo_sabin_to_non_uniform};
 pub use curve::{CurveFinetune, CurveFinetuneParams, CurveFinetuneReport, finetune_curve};
 pub use curve_alpha::{ScalarFunction, ValuesOn, alpha_from_values, values_on};
@@ -50,11 +54,7 @@ pub use curve_exact::{
 pub use curve_io::{curve_json, read_alpha, read_curve, write_json};
 pub use curve_picture::{CurveLayer, comparison_layers, curve_layer, curve_picture};
 pub use edge_loops::{EdgeLoop, edge_loops};
-pub use levenberg_marquardt::{
-    FORCING_MAX, FinetuneMethod, LeastSquares, LmParams, LmRun, LmTimings, REFINEMENT_ITERATIONS,
-    Residuals, levenberg_marquardt,
-};
-pub use refined_step::{RELATIVE_RESIDUAL, preconditioned_solution};
+pub use method::FinetuneMethod;
 pub use surface::{SurfaceFineTune, SurfaceFineTuneParams, SurfaceFineTuneReport, SurfaceScheme};
 pub use surface_energy::{SpringEnergy, angle_and_gradients, joint_angles};
 pub use surface_targets::{LegKind, loop_targets};

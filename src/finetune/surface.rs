@@ -9,11 +9,12 @@
 use std::time::Instant;
 
 use crate::error::{Error, Result};
+use crate::linalg::{LmTimings, REFINEMENT_ITERATIONS};
 use crate::math::{Point3, Real, bounding_box};
 use crate::mesh::PolyMesh;
 use crate::topology::{Level, find_edge};
 
-use super::levenberg_marquardt::{FinetuneMethod, LmTimings, REFINEMENT_ITERATIONS};
+use super::method::FinetuneMethod;
 use super::surface_energy::{SpringEnergy, joint_angles};
 use super::surface_solve::minimise;
 use super::surface_targets::{LegKind, loop_targets};
@@ -50,7 +51,7 @@ pub struct SurfaceFineTuneParams {
     pub method: FinetuneMethod,
     /// Levenberg-Marquardt: conjugate-gradient iterations allowed to solve a
     /// step with the previous factorisation before factoring afresh
-    /// (`refined_step`); default [`REFINEMENT_ITERATIONS`] (15), 0 factors
+    /// (`linalg::refined_step`); default [`REFINEMENT_ITERATIONS`] (15), 0 factors
     /// every step.
     pub refinement_iterations: usize,
 }

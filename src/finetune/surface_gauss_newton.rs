@@ -11,10 +11,10 @@
 
 use rayon::prelude::*;
 
+use crate::linalg::{LeastSquares, Residuals};
 use crate::math::{Point3, Real, Vector3};
 
 use super::angle_curvature::transverse_rows;
-use super::levenberg_marquardt::{LeastSquares, Residuals};
 use super::surface_energy::{SpringEnergy, angle_and_gradients};
 
 /// Energy (14) over the displacements `z` of the free vertices (3 per vertex).

@@ -22,12 +22,11 @@ use argmin::solver::linesearch::MoreThuenteLineSearch;
 use nalgebra::DVector;
 
 use crate::error::{Error, Result};
+use crate::linalg::{LeastSquares, LmParams, LmTimings, levenberg_marquardt};
 use crate::math::{Point3, Real};
 
 use super::SurfaceFineTuneParams;
-use super::levenberg_marquardt::{
-    FinetuneMethod, LeastSquares, LmParams, LmTimings, levenberg_marquardt,
-};
+use super::method::FinetuneMethod;
 use super::surface_energy::SpringEnergy;
 use super::surface_gauss_newton::SurfacePointProblem;
 

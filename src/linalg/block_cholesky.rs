@@ -558,7 +558,7 @@ fn in_pool_if<R: Send>(parallel: bool, f: impl FnOnce() -> R + Send) -> R {
 
 /// `(a(), b())`, on two threads (`rayon::join`) if `parallel`, else in turn
 /// on this one (a join from outside rayon's pool costs a hand-over to it).
-pub(crate) fn join_if<A: Send, B: Send>(
+pub(super) fn join_if<A: Send, B: Send>(
     parallel: bool,
     a: impl FnOnce() -> A + Send,
     b: impl FnOnce() -> B + Send,

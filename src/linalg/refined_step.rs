@@ -10,10 +10,10 @@
 //! numeric factorisation. When it does not converge within the allowed
 //! iterations the caller factors `A` afresh.
 
-use crate::linalg::{CgStop, Preconditioner, cg};
 use crate::math::Real;
 
-use crate::linalg::{Cholesky, CholeskyPattern};
+use super::block_cholesky::{Cholesky, CholeskyPattern};
+use super::cg::{CgStop, Preconditioner, cg};
 
 /// The tightest convergence asked of a step: `|b − A x| ≤ RELATIVE_RESIDUAL
 /// · |b|`, `1e-10` (a direct solve of these systems leaves about `1e-13`).

@@ -1,12 +1,14 @@
 //! Levenberg-Marquardt minimisation of a sum of squares `E = Σ_k r_k(z)²`
-//! with a sparse Gauss-Newton matrix, the default solver of fine tuning.
+//! with a sparse Gauss-Newton matrix, the default solver of fine tuning
+//! (`finetune`'s curve and surface energies).
 //!
 //! Energies (13) and (14) of the fine-tuning paper are sums of squared
 //! spring residuals (`√k_l (l − l_opt)`, `√k_a (θ − θ_opt)`), so with
 //! `g = 2 Jᵀ r` and `H = 2 Jᵀ J` each step solves
 //! `(H + λ D) δ = −g`, `D = diag(H)` (Marquardt 1963; floored at `1e-12`
 //! of its largest entry so that it is positive definite), by the sparse
-//! Cholesky of `sparse_cholesky` (pattern and ordering computed once).
+//! 3 × 3-block Cholesky of `block_cholesky` (pattern and ordering computed
+//! once).
 //! After the first factorisation a step is first solved by conjugate
 //! gradients preconditioned with the last factor (`refined_step`,
 //! [`LmParams::refinement_iterations`]), only as accurately as the
@@ -38,38 +40,11 @@ use std::time::Instant;
 
 use crate::math::Real;
 
+use super::block_cholesky::{CholeskyPattern, join_if};
 use super::refined_step::preconditioned_solution;
-use crate::linalg::{CholeskyPattern, join_if};
 
 /// Problems with at least this many runs of rows assemble `H` on two threads.
 const PARALLEL_RUNS: usize = 2048;
-
-/// Which minimiser fine tuning uses.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
-pub enum FinetuneMethod {
-    /// Levenberg-Marquardt on the sparse Gauss-Newton matrix (this module):
-    /// tens of iterations. The default.
-    #[default]
-    LevenbergMarquardt,
-    /// argmin's nonlinear conjugate gradient (Polak-Ribière+, Moré-Thuente
-    /// line search), the method issue 8 named: thousands of iterations on
-    /// the same problems.
-    NonlinearCg,
-}
-
-impl std::str::FromStr for FinetuneMethod {
-    type Err = crate::error::Error;
-    /// `lm` or `ncg`.
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "lm" => Ok(FinetuneMethod::LevenbergMarquardt),
-            "ncg" => Ok(FinetuneMethod::NonlinearCg),
-            _ => Err(crate::error::Error::Input(format!(
-                "unknown method {s:?}: expected lm or ncg"
-            ))),
-        }
-    }
-}
 
 /// Residual values and their sparse gradients, row by row.
 #[derive(Clone, Debug, Default)]
