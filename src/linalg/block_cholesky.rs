@@ -55,6 +55,8 @@ pub struct CholeskyPattern {
     c_rows: Vec<usize>,
     /// Elimination tree, row patterns and block column starts of `L`.
     symbolic: Symbolic,
+    /// Block row of every block of `L` ([`Symbolic::column_rows`]).
+    l_rows: Vec<usize>,
     /// `(a, b)`: columns `0 … a` (part A) and `a … b` (part B) share no
     /// row of `L`, so they are eliminated in parallel; the columns from `b`
     /// on (the separator) follow. `(nb, nb)` when the factor is serial.
@@ -73,7 +75,6 @@ const PARALLEL_BLOCKS: usize = 512;
 #[derive(Clone, Debug)]
 pub struct Cholesky<'a> {
     pattern: &'a CholeskyPattern,
-    rows: Vec<usize>,
     blocks: Vec<Matrix3<Real>>,
     /// `L_kk⁻¹` of every diagonal block.
     inverse: Vec<Matrix3<Real>>,
@@ -223,6 +224,7 @@ impl CholeskyPattern {
             padding,
             c_start,
             c_rows,
+            l_rows: symbolic.column_rows(),
             symbolic,
             split,
         };
@@ -306,17 +308,11 @@ impl CholeskyPattern {
         };
         let l_start = &self.symbolic.l_start;
         let nnz = self.symbolic.num_entries();
-        let mut rows = vec![0; nnz];
         let mut blocks: Vec<Matrix3<Real>> = vec![Matrix3::zeros(); nnz];
         let mut inverse: Vec<Matrix3<Real>> = vec![Matrix3::zeros(); nb];
         let mut next: Vec<usize> = l_start[..nb].to_vec();
-        let [mut a, mut b, mut sep] = self.columns(
-            [a_end, b_end],
-            &mut rows,
-            &mut blocks,
-            &mut inverse,
-            &mut next,
-        );
+        let [mut a, mut b, mut sep] =
+            self.columns([a_end, b_end], &mut blocks, &mut inverse, &mut next);
         // Rows of A and of B: each touches only its own columns.
         let own_rows = |cols: &mut Columns<'_>, range: std::ops::Range<usize>| {
             if range.is_empty() {
@@ -328,7 +324,7 @@ impl CholeskyPattern {
                     x[self.c_rows[p]] += block(p);
                 }
                 let row = self.symbolic.row(k);
-                let d = diagonal(k) - cols.eliminate(l_start, k, row, &mut x);
+                let d = diagonal(k) - cols.eliminate(l_start, row, &mut x);
                 cols.close(k, d)?;
             }
             Some(())
@@ -355,20 +351,19 @@ impl CholeskyPattern {
             }
             let [xa, xb, xs] = &mut x;
             let (da, db) = rayon::join(
-                || a.eliminate(l_start, k, &parts[0], xa),
-                || b.eliminate(l_start, k, &parts[1], xb),
+                || a.eliminate(l_start, &parts[0], xa),
+                || b.eliminate(l_start, &parts[1], xb),
             );
             for r in b_end..k {
                 xs[r] += xa[r] + xb[r];
                 xa[r] = Matrix3::zeros();
                 xb[r] = Matrix3::zeros();
             }
-            let ds = sep.eliminate(l_start, k, &parts[2], xs);
+            let ds = sep.eliminate(l_start, &parts[2], xs);
             sep.close(k, diagonal(k) - da - db - ds)?;
         }
         Some(Cholesky {
             pattern: self,
-            rows,
             blocks,
             inverse,
         })
@@ -376,16 +371,16 @@ impl CholeskyPattern {
 
     /// The columns of `L` cut at `cuts` into three ranges.
     fn columns<'s>(
-        &self,
+        &'s self,
         cuts: [usize; 2],
-        rows: &'s mut [usize],
         blocks: &'s mut [Matrix3<Real>],
         inverse: &'s mut [Matrix3<Real>],
         next: &'s mut [usize],
     ) -> [Columns<'s>; 3] {
         let [a, b] = cuts;
         let (la, lb) = (self.symbolic.l_start[a], self.symbolic.l_start[b]);
-        let mut rows = cut(rows, la, lb).into_iter();
+        let l_rows = &self.l_rows;
+        let mut rows = [&l_rows[..la], &l_rows[la..lb], &l_rows[lb..]].into_iter();
         let mut blocks = cut(blocks, la, lb).into_iter();
         let mut inverse = cut(inverse, a, b).into_iter();
         let mut next = cut(next, a, b).into_iter();
@@ -406,7 +401,8 @@ struct Columns<'s> {
     first: usize,
     /// Position of the first column's first block in the whole factor.
     offset: usize,
-    rows: &'s mut [usize],
+    /// Block rows of this range's blocks (the pattern's `l_rows`).
+    rows: &'s [usize],
     blocks: &'s mut [Matrix3<Real>],
     inverse: &'s mut [Matrix3<Real>],
     /// Next free position (in the whole factor) of every column.
@@ -421,7 +417,6 @@ impl Columns<'_> {
     fn eliminate(
         &mut self,
         l_start: &[usize],
-        k: usize,
         stack: &[usize],
         x: &mut [Matrix3<Real>],
     ) -> Matrix3<Real> {
@@ -435,7 +430,6 @@ impl Columns<'_> {
                 x[self.rows[p]] -= self.blocks[p] * z;
             }
             zz += z.transpose() * z;
-            self.rows[end] = k;
             self.blocks[end] = z.transpose();
             self.next[c] += 1;
         }
@@ -452,7 +446,6 @@ impl Columns<'_> {
         let c = k - self.first;
         self.inverse[c] = l.try_inverse()?;
         let at = self.next[c] - self.offset;
-        self.rows[at] = k;
         self.blocks[at] = l;
         self.next[c] += 1;
         Some(())
@@ -510,7 +503,7 @@ impl Cholesky<'_> {
             let y = self.inverse[j] * x[c];
             x[c] = y;
             for q in l_start[j] + 1..l_start[j + 1] {
-                let (r, u) = (self.rows[q], self.blocks[q] * y);
+                let (r, u) = (self.pattern.l_rows[q], self.blocks[q] * y);
                 if r < sep {
                     x[r - first] -= u;
                 } else {
@@ -531,7 +524,7 @@ impl Cholesky<'_> {
             let j = first + c;
             let mut v = x[c];
             for q in l_start[j] + 1..l_start[j + 1] {
-                let r = self.rows[q];
+                let r = self.pattern.l_rows[q];
                 let xr = if r < end {
                     x[r - first]
                 } else {
