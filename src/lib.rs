@@ -15,14 +15,40 @@
 //! # let _ = io::MeshFormat::Obj;
 //! ```
 //!
-//! Modules: [`math`] (scalar and point types), [`error`], [`memory`] (the memory budget), [`allocator`] (the binary's one-line out-of-memory exit), [`mesh`] (polygon
-//! meshes, point clouds), [`io`] (OBJ, PLY, OFF, XYZ), [`topology`] (edges,
-//! adjacency, tags), [`subdivision`] (Catmull-Clark refinement, B-spline curves), [`stencil`]
-//! (CSR stencil tables), [`limit`] (limit masks, exact evaluation, closest point),
-//! [`metrics`] (point-to-mesh distances, Chamfer, Hausdorff), [`render`]
-//! (software rasteriser for pictures), [`finetune`] (fine tuning of curves by
-//! scaling derivatives), [`lattice`] (volume lattices, Catmull-Clark volume
-//! refinement), [`solid`] (dynamic subdivision solids and sculpting tools).
+//! The main job, fitting a scan (what `subdyn fit` does with its defaults):
+//!
+//! ```
+//! use subdyn::fit::{FitParams, FitStart, crease_options, fit_from_start, init::InitParams};
+//! let scan = subdyn::examples::demo_scan()?;                 // or io::read_points("scan.ply")
+//! let start = FitStart::Method(InitParams::default());       // the automatic initial cage
+//! let run = fit_from_start(&scan, &start, &FitParams::default(), &mut |_, _, _| {})?;
+//! let last = run.result.report.levels.last().unwrap();       // per level: error, steps, time
+//! assert!(last.error.p95_pct < 0.2);  // % of the diagonal; the scan has 0.1 % noise
+//! let tags = crease_options(&run.result.creases);            // sharp edges found in the scan
+//! let (surface, _normals) =
+//!     subdyn::limit::limit_surface_mesh(&run.result.control, &tags, 4, false)?;
+//! assert!(surface.num_faces() > run.result.control.num_faces()); // io::write_mesh(...)
+//! # Ok::<(), subdyn::Error>(())
+//! ```
+//!
+//! Modules, from the foundation up: [`math`] (scalar and point types),
+//! [`error`], [`memory`] (the memory budget), [`allocator`] (the binary's
+//! one-line out-of-memory exit), [`mesh`] (polygon meshes, point clouds),
+//! [`io`] (OBJ, PLY, OFF, XYZ), [`examples`] (small embedded meshes and the
+//! demo scan), [`topology`] (edges, adjacency, tags), [`subdivision`]
+//! (Catmull-Clark refinement, B-spline curves), [`stencil`] (CSR stencil
+//! tables), [`linalg`] (conjugate gradients, orderings, sparse Cholesky,
+//! Levenberg-Marquardt), [`limit`] (limit masks, exact evaluation, closest
+//! point), [`metrics`] (point-to-mesh distances, Chamfer, Hausdorff),
+//! [`volume`] (scalar grids and image forces' preprocessing), [`dynamics`]
+//! (mass, damping and stiffness of dynamic Catmull-Clark surfaces, implicit
+//! integration), [`forces`] (data springs, image and inflation forces),
+//! [`fit`] (fitting point clouds and recovering shapes from volumes),
+//! [`lattice`] (volume lattices, Catmull-Clark volume refinement), [`ffd`]
+//! (free-form deformation with lattices), [`solid`] (dynamic subdivision
+//! solids and sculpting tools), [`finetune`] (fine tuning of Doo-Sabin and
+//! Catmull-Clark curves and surfaces), [`render`] (software rasteriser for
+//! pictures). `docs/ARCHITECTURE.md` has the layering and the design notes.
 
 #![warn(missing_docs)]
 

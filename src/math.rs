@@ -136,3 +136,33 @@ pub fn perpendicular_basis(d: &Vector3) -> [Vector3; 2] {
     let e1 = d.cross(&helper).normalize();
     [e1, d.cross(&e1)]
 }
+
+/// Groups `pairs` `(key, item)`, every `key < n`, in compressed-row form (a
+/// stable counting sort; the transposition of Gustavson, ACM TOMS 4(3),
+/// 1978): returns the offsets (`n + 1` of them) and the
+/// items, those of key `k` at `items[offsets[k]..offsets[k + 1]]` in the
+/// order `pairs` gives them.
+pub fn group_by_key<T: Copy + Default>(
+    n: usize,
+    pairs: impl Iterator<Item = (usize, T)> + Clone,
+) -> (Vec<usize>, Vec<T>) {
+    let mut offsets = vec![0usize; n + 1];
+    for (k, _) in pairs.clone() {
+        offsets[k + 1] += 1;
+    }
+    for k in 0..n {
+        offsets[k + 1] += offsets[k];
+    }
+    let mut fill = offsets.clone();
+    let mut items = vec![T::default(); offsets[n]];
+    for (k, t) in pairs {
+        items[fill[k]] = t;
+        fill[k] += 1;
+    }
+    (offsets, items)
+}
+
+/// Offsets of a relation whose items are `u32` indices, as `u32`.
+pub(crate) fn u32_offsets(offsets: Vec<usize>) -> Vec<u32> {
+    offsets.into_iter().map(|o| o as u32).collect()
+}

@@ -22,11 +22,12 @@ use std::time::Instant;
 use clap::Args;
 use serde_json::json;
 
-use subdyn::ffd::{Ffd, FfdParams};
+use subdyn::ffd::Ffd;
 use subdyn::lattice::{BoxLatticeParams, LatticeHierarchy, box_grid, box_lattice, refined_cells};
 use subdyn::math::{Point3, Real, Vector3};
 
 use super::common::{print_stdout, thousands, timed};
+use super::ffd::embedding_stage;
 use super::progress::Progress;
 
 /// Arguments of `subdyn bench ffd`.
@@ -97,14 +98,7 @@ pub fn bench_ffd(args: &BenchFfdArgs) -> anyhow::Result<()> {
     let (lattice, lattice_s) = timed(|| box_lattice(points, &lattice_params));
     let lattice = lattice?;
 
-    progress.stage(format!(
-        "refining the lattice {} times and embedding",
-        args.levels
-    ));
-    let params = FfdParams {
-        levels: args.levels,
-        ..Default::default()
-    };
+    let params = embedding_stage(&progress, args.levels);
     let mut best: Option<Ffd> = None;
     let (mut refine_s, mut embed_s) = (Real::INFINITY, Real::INFINITY);
     for _ in 0..args.repeat {

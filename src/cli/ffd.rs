@@ -112,6 +112,16 @@ fn read_moves(path: &Path, rest: &[Point3]) -> anyhow::Result<Vec<Point3>> {
     Ok(out)
 }
 
+/// Says that the lattice is refined `levels` times and the model embedded;
+/// the parameters for it.
+pub fn embedding_stage(progress: &Progress, levels: usize) -> FfdParams {
+    progress.stage(format!("refining the lattice {levels} times and embedding"));
+    FfdParams {
+        levels,
+        ..Default::default()
+    }
+}
+
 /// Runs `subdyn ffd`.
 pub fn run(args: &FfdArgs) -> anyhow::Result<()> {
     let start = Instant::now();
@@ -148,14 +158,7 @@ pub fn run(args: &FfdArgs) -> anyhow::Result<()> {
         (None, Some(path)) => read_moves(path, &lattice.positions)?,
         (None, None) => anyhow::bail!("give --deformed or --moves"),
     };
-    progress.stage(format!(
-        "refining the lattice {} times and embedding",
-        args.levels
-    ));
-    let params = FfdParams {
-        levels: args.levels,
-        ..Default::default()
-    };
+    let params = embedding_stage(&progress, args.levels);
     let ffd = Ffd::new(&lattice, &mesh.positions, &params)?;
     let t = Instant::now();
     // An error here is about the moved lattice, not the output.

@@ -20,7 +20,7 @@ use super::common::{
     Written, about_file, check_mesh_output, check_output_dir, seconds, thousands, warn,
     write_report,
 };
-use super::options::{LimitFacesArgs, read_polygon_mesh};
+use super::options::{LimitOutArgs, read_polygon_mesh};
 use super::progress::Progress;
 
 /// Which statistic `--tol` applies to.
@@ -125,14 +125,8 @@ pub struct FitArgs {
     /// (massless) dynamics, above 0 the paper's second-order dynamics.
     #[arg(long, value_name = "μ", default_value_t = FitParams::default().mass)]
     pub mass: f64,
-    /// Also write a dense limit-surface tessellation (K×K per quad, see --tess).
-    #[arg(long, value_name = "SURF")]
-    pub limit_out: Option<PathBuf>,
-    /// Tessellation rate of --limit-out.
-    #[arg(long, value_name = "K", default_value_t = 4)]
-    pub tess: usize,
     #[command(flatten)]
-    pub faces: LimitFacesArgs,
+    pub limit: LimitOutArgs,
     /// Write a JSON report (per level: control points, time, CG iterations, errors).
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
@@ -151,17 +145,12 @@ pub struct FitArgs {
 pub fn run(args: &FitArgs) -> anyhow::Result<()> {
     let start = Instant::now();
     check_mesh_output(&args.output)?;
-    if let Some(p) = &args.limit_out {
-        check_mesh_output(p)?;
-    }
+    args.limit.check()?;
     if let Some(p) = &args.report {
         check_output_dir(p)?;
     }
     if let Some(p) = &args.plot {
         subdyn::render::check_png_path(p)?;
-    }
-    if args.tess == 0 || args.tess > 64 {
-        anyhow::bail!("--tess {} is out of range: expected 1 to 64", args.tess);
     }
     let params = FitParams {
         tolerance_pct: args.tol,
@@ -232,12 +221,12 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             "crease tags of the control mesh (--creases reads them)",
         );
     }
-    if let Some(path) = &args.limit_out {
+    if let Some(path) = &args.limit.limit_out {
         let (surf, normals) = limit_surface_mesh(
             &result.control,
             &crease_options(&result.creases),
-            args.tess,
-            args.faces.quads,
+            args.limit.tess,
+            args.limit.faces.quads,
         )?;
         write_mesh(path, &surf, Some(&normals)).map_err(|e| about_file(e, path))?;
         written.add(path, "limit surface");
@@ -252,7 +241,7 @@ pub fn run(args: &FitArgs) -> anyhow::Result<()> {
             "command": "fit",
             "input": name,
             "output": args.output.display().to_string(),
-            "limit_out": args.limit_out.as_ref().map(|p| p.display().to_string()),
+            "limit_out": args.limit.limit_out.as_ref().map(|p| p.display().to_string()),
             "crease_file": crease_file.as_ref().map(|p| p.display().to_string()),
         });
         if let Some(map) = value.as_object_mut() {

@@ -11,7 +11,7 @@ use subdyn::mesh::PolyMesh;
 use subdyn::subdivision::{BoundaryRule, RefineOptions, Refiner, TriangleRule};
 use subdyn::topology::CreaseMethod;
 
-use super::common::{about_file, thousands, warn};
+use super::common::{about_file, check_mesh_output, thousands, warn};
 
 /// Boundary interpolation, as on the command line.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
@@ -165,6 +165,34 @@ pub fn warn_isolated(mesh: &PolyMesh, name: &str, quiet: bool) {
                 thousands(isolated.len())
             ),
         );
+    }
+}
+
+/// `--limit-out`, `--tess` and `--quads` of the verbs that make a control
+/// mesh (`fit`, `recover`).
+#[derive(Clone, Debug, Args)]
+pub struct LimitOutArgs {
+    /// Also write a dense limit-surface tessellation (K×K per quad, see --tess).
+    #[arg(long, value_name = "SURF")]
+    pub limit_out: Option<PathBuf>,
+    /// Tessellation rate of --limit-out (and of recover's slice contours):
+    /// 1 to 64.
+    #[arg(long, value_name = "K", default_value_t = 4)]
+    pub tess: usize,
+    #[command(flatten)]
+    pub faces: LimitFacesArgs,
+}
+
+impl LimitOutArgs {
+    /// Checks the output path and the rate before any work is done.
+    pub fn check(&self) -> anyhow::Result<()> {
+        if let Some(p) = &self.limit_out {
+            check_mesh_output(p)?;
+        }
+        if self.tess == 0 || self.tess > 64 {
+            anyhow::bail!("--tess {} is out of range: expected 1 to 64", self.tess);
+        }
+        Ok(())
     }
 }
 

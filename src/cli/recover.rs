@@ -27,7 +27,7 @@ use super::common::{
     write_report,
 };
 use super::memory::{StagePeaks, peak_rss, stage_peak};
-use super::options::{LimitFacesArgs, read_polygon_mesh};
+use super::options::{LimitOutArgs, read_polygon_mesh};
 use super::progress::Progress;
 
 /// Arguments of `subdyn recover`.
@@ -128,14 +128,8 @@ pub struct RecoverArgs {
     /// Bending weight λ_b of the thin plate.
     #[arg(long, value_name = "λ", default_value_t = RecoverParams::default().bending)]
     pub bending: f64,
-    /// Also write a dense limit-surface tessellation (K×K per quad, see --tess).
-    #[arg(long, value_name = "SURF")]
-    pub limit_out: Option<PathBuf>,
-    /// Tessellation rate of --limit-out and of the slice contours.
-    #[arg(long, value_name = "K", default_value_t = 4)]
-    pub tess: usize,
     #[command(flatten)]
-    pub faces: LimitFacesArgs,
+    pub limit: LimitOutArgs,
     /// Write a JSON report (stage times, per level: control points, steps, offsets).
     #[arg(long, value_name = "FILE")]
     pub report: Option<PathBuf>,
@@ -197,17 +191,12 @@ fn parse_triple(s: &str) -> Result<[f64; 3], String> {
 pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     let start = Instant::now();
     check_mesh_output(&args.output)?;
-    if let Some(p) = &args.limit_out {
-        check_mesh_output(p)?;
-    }
+    args.limit.check()?;
     if let Some(p) = &args.report {
         check_output_dir(p)?;
     }
     if let Some(dir) = &args.slices_png {
         subdyn::io::check_output_dir_path(dir)?;
-    }
-    if args.tess == 0 || args.tess > 64 {
-        anyhow::bail!("--tess {} is out of range: expected 1 to 64", args.tess);
     }
     let params = RecoverParams {
         boundary: match args.iso.or(args.preset.map(CtPreset::hounsfield)) {
@@ -319,11 +308,11 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     written.add(&args.output, "control mesh");
     let surface = |mesh: &PolyMesh| -> anyhow::Result<(PolyMesh, Vec<subdyn::math::Vector3>)> {
         let refiner = Refiner::new(mesh, &RefineOptions::default())?;
-        Ok(tessellate(&refiner, &mesh.positions, args.tess)?)
+        Ok(tessellate(&refiner, &mesh.positions, args.limit.tess)?)
     };
     let (surf, normals) = surface(control)?;
-    if let Some(path) = &args.limit_out {
-        write_mesh(path, &args.faces.mesh(&surf), Some(&normals))
+    if let Some(path) = &args.limit.limit_out {
+        write_mesh(path, &args.limit.faces.mesh(&surf), Some(&normals))
             .map_err(|e| about_file(e, path))?;
         written.add(path, "limit surface");
     }
@@ -353,7 +342,7 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
             "padding": PreparedVolume::PADDING,
             "poor_result": problems,
             "output": args.output.display().to_string(),
-            "limit_out": args.limit_out.as_ref().map(|p| p.display().to_string()),
+            "limit_out": args.limit.limit_out.as_ref().map(|p| p.display().to_string()),
             "init": init_json,
             "stages_s": {
                 "read": read_s,

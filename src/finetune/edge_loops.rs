@@ -59,41 +59,34 @@ pub fn edge_loops(level: &Level) -> Vec<EdgeLoop> {
         }
         used[start] = true;
         let [a, b] = level.edge_verts[start];
-        // Walk forward from b.
-        let mut fwd_v = vec![a, b];
-        let mut fwd_e = vec![start as u32];
-        let mut closed = false;
-        let (mut v, mut e) = (b, start as u32);
-        while let Some(next) = opposite(&rings, v, e) {
-            if next as usize == start {
-                closed = true;
-                break;
-            }
-            if used[next as usize] {
-                break;
-            }
-            used[next as usize] = true;
-            v = level.other_vertex(next as usize, v);
-            e = next;
-            fwd_e.push(e);
-            fwd_v.push(v);
-        }
-        if closed {
-            fwd_v.pop(); // the last vertex is `a` again
-        } else {
-            // Walk backward from a and prepend.
-            let (mut v, mut e) = (a, start as u32);
-            let (mut back_v, mut back_e) = (Vec::new(), Vec::new());
+        // Walks on from vertex `v` away over edge `e`, marking edges used,
+        // pushing each edge and its far vertex; `true` when it came back to
+        // `start` (a closed loop).
+        let mut walk = |mut v: u32, mut e: u32, vs: &mut Vec<u32>, es: &mut Vec<u32>| {
             while let Some(next) = opposite(&rings, v, e) {
+                if next as usize == start {
+                    return true;
+                }
                 if used[next as usize] {
                     break;
                 }
                 used[next as usize] = true;
                 v = level.other_vertex(next as usize, v);
                 e = next;
-                back_e.push(e);
-                back_v.push(v);
+                es.push(e);
+                vs.push(v);
             }
+            false
+        };
+        // Forward from b; an open loop also backward from a, prepended.
+        let mut fwd_v = vec![a, b];
+        let mut fwd_e = vec![start as u32];
+        let closed = walk(b, start as u32, &mut fwd_v, &mut fwd_e);
+        if closed {
+            fwd_v.pop(); // the last vertex is `a` again
+        } else {
+            let (mut back_v, mut back_e) = (Vec::new(), Vec::new());
+            walk(a, start as u32, &mut back_v, &mut back_e);
             back_v.reverse();
             back_e.reverse();
             back_v.extend(fwd_v);

@@ -23,7 +23,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::limit::{ClosestPoint, PatchTable};
-use crate::math::{Point3, Real, reduction_parts};
+use crate::math::{Point3, Real, group_by_key, reduction_parts};
 use crate::stencil::StencilTable;
 
 use super::SpringSystem;
@@ -153,21 +153,14 @@ impl PatchAssembly {
         let ring_map = offsets_of(ring.iter().map(|&w| s.row(w as usize).0.len()));
         let support: Vec<u32> = supports.concat();
         // The patches over each control point, then each row's columns.
-        let mut count = vec![0usize; n + 1];
-        for &c in &support {
-            count[c as usize + 1] += 1;
-        }
-        for i in 0..n {
-            count[i + 1] += count[i];
-        }
-        let mut fill = count.clone();
-        let mut patches_of = vec![0u32; support.len()];
-        for (f, w) in support_offsets.windows(2).enumerate() {
-            for &c in &support[w[0]..w[1]] {
-                patches_of[fill[c as usize]] = f as u32;
-                fill[c as usize] += 1;
-            }
-        }
+        let (count, patches_of) = group_by_key(
+            n,
+            (support_offsets.windows(2).enumerate()).flat_map(|(f, w)| {
+                support[w[0]..w[1]]
+                    .iter()
+                    .map(move |&c| (c as usize, f as u32))
+            }),
+        );
         let rows: Vec<Vec<u32>> = (0..n)
             .into_par_iter()
             .map_init(

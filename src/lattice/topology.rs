@@ -10,6 +10,7 @@
 use std::collections::HashMap;
 
 use crate::error::{Error, Result};
+use crate::math::{group_by_key, u32_offsets};
 
 /// Marker for "no cell" in [`LatticeTopology::face_cells`].
 pub const NO_CELL: u32 = u32::MAX;
@@ -40,19 +41,8 @@ impl Csr {
 
     /// Groups `(row, item)` pairs into `rows` lists (items in pair order).
     pub fn from_pairs(rows: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) -> Csr {
-        let mut offsets = vec![0u32; rows + 1];
-        for (r, _) in pairs.clone() {
-            offsets[r as usize + 1] += 1;
-        }
-        for i in 0..rows {
-            offsets[i + 1] += offsets[i];
-        }
-        let mut next = offsets.clone();
-        let mut items = vec![0u32; offsets[rows] as usize];
-        for (r, x) in pairs {
-            items[next[r as usize] as usize] = x;
-            next[r as usize] += 1;
-        }
+        let (offsets, items) = group_by_key(rows, pairs.map(|(r, x)| (r as usize, x)));
+        let offsets = u32_offsets(offsets);
         Csr { offsets, items }
     }
 

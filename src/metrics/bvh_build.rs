@@ -160,6 +160,16 @@ fn subtree(input: &Input, order: &mut [u32], start: usize, depth: usize, out: &m
     append(out, r);
 }
 
+/// Partitions `order` at its centroid median along `axis`; returns the
+/// size of the left part.
+fn median_split(order: &mut [u32], centroids: &[[Real; 3]], axis: usize) -> usize {
+    let mid = order.len() / 2;
+    order.select_nth_unstable_by(mid, |&x, &y| {
+        centroids[x as usize][axis].total_cmp(&centroids[y as usize][axis])
+    });
+    mid
+}
+
 /// Partitions `order` and returns the size of the left part, or `None` for a leaf.
 fn choose_split(
     order: &mut [u32],
@@ -176,11 +186,7 @@ fn choose_split(
         if n <= MAX_LEAF {
             return None;
         }
-        let mid = n / 2;
-        order.select_nth_unstable_by(mid, |&x, &y| {
-            centroids[x as usize][axis].total_cmp(&centroids[y as usize][axis])
-        });
-        return Some(mid);
+        return Some(median_split(order, centroids, axis));
     }
     let scale = BINS as Real / extent[axis];
     let bin_of = |t: u32| {
@@ -226,11 +232,7 @@ fn choose_split(
         if n <= MAX_LEAF {
             return None;
         }
-        let mid = n / 2;
-        order.select_nth_unstable_by(mid, |&x, &y| {
-            centroids[x as usize][axis].total_cmp(&centroids[y as usize][axis])
-        });
-        return Some(mid);
+        return Some(median_split(order, centroids, axis));
     }
     let split_bin = best.1;
     let mut i = 0;

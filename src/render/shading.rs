@@ -69,22 +69,11 @@ pub fn corner_normals(mesh: &PolyMesh, crease_deg: Real) -> Vec<Vector3> {
         .map(|n| n.try_normalize(0.0).unwrap_or_else(Vector3::zeros))
         .collect();
     // Faces around each vertex, in CSR form.
-    let nv = mesh.num_vertices();
-    let mut start = vec![0usize; nv + 1];
-    for &v in &mesh.face_vertices {
-        start[v as usize + 1] += 1;
-    }
-    for v in 0..nv {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start.clone();
-    let mut around = vec![0u32; mesh.face_vertices.len()];
-    for (f, face) in mesh.faces().enumerate() {
-        for &v in face {
-            around[fill[v as usize]] = f as u32;
-            fill[v as usize] += 1;
-        }
-    }
+    let (start, around) = crate::math::group_by_key(
+        mesh.num_vertices(),
+        (0..mesh.num_faces())
+            .flat_map(|f| mesh.face(f).iter().map(move |&v| (v as usize, f as u32))),
+    );
     let cos_crease = crease_deg.clamp(0.0, 180.0).to_radians().cos();
     let mut out = Vec::with_capacity(mesh.face_vertices.len());
     for (f, face) in mesh.faces().enumerate() {

@@ -131,12 +131,7 @@ impl Solid {
         check_step(self, h)?;
         let start = Instant::now();
         // f − h K ḋ (forces, damping, ropes) and the Hessians in one pass.
-        let mut f: Vec<Vector3> = self
-            .mass
-            .iter()
-            .zip(&self.dd)
-            .map(|(m, v)| -self.params.damping * m * v)
-            .collect();
+        let mut f = self.damping_forces();
         let mut hess = std::mem::take(&mut self.hess);
         let spring_energy = self.springs.add_forces_minus_hessian_product(
             &self.d,

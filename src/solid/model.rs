@@ -332,15 +332,19 @@ impl Solid {
         crate::mesh::PolyMesh::from_faces(positions, &faces)
     }
 
-    /// Total forces on the mass points: springs, ropes and damping `−γ m_i ḋ_i`;
-    /// returns them with the spring energy.
-    pub(crate) fn mass_point_forces(&self) -> (Vec<Vector3>, Real) {
-        let mut f: Vec<Vector3> = self
-            .mass
+    /// The damping forces `−γ m_i ḋ_i` on the mass points.
+    pub(crate) fn damping_forces(&self) -> Vec<Vector3> {
+        self.mass
             .iter()
             .zip(&self.dd)
             .map(|(m, v)| -self.params.damping * m * v)
-            .collect();
+            .collect()
+    }
+
+    /// Total forces on the mass points: springs, ropes and damping `−γ m_i ḋ_i`;
+    /// returns them with the spring energy.
+    pub(crate) fn mass_point_forces(&self) -> (Vec<Vector3>, Real) {
+        let mut f = self.damping_forces();
         let e = self
             .springs
             .add_forces(&self.d, self.params.stiffness, &mut f);

@@ -4,8 +4,9 @@
 use rayon::prelude::*;
 
 use super::StencilTable;
+use super::csr::RowAccumulator;
 use crate::error::{Error, Result};
-use crate::math::Real;
+use crate::math::{Real, group_by_key};
 
 /// Dense square matrices, each over a few columns of a larger space, stored
 /// one after the other (element `e` is `cols[col_start[e]..col_start[e + 1]]`
@@ -76,28 +77,19 @@ impl StencilTable {
             )));
         }
         // Which (element, local row) pairs touch each global row.
-        let mut counts = vec![0usize; n + 1];
-        for &c in &elements.cols {
-            counts[c as usize + 1] += 1;
-        }
-        for r in 0..n {
-            counts[r + 1] += counts[r];
-        }
-        let mut fill = counts.clone();
-        let mut touching = vec![(0u32, 0u32); counts[n]];
-        for e in 0..elements.len() {
-            let (cols, _) = elements.get(e);
-            for (k, &c) in cols.iter().enumerate() {
-                touching[fill[c as usize]] = (e as u32, k as u32);
-                fill[c as usize] += 1;
-            }
-        }
+        let (counts, touching) = group_by_key(
+            n,
+            (0..elements.len()).flat_map(|e| {
+                let (cols, _) = elements.get(e);
+                (cols.iter().enumerate()).map(move |(k, &c)| (c as usize, (e as u32, k as u32)))
+            }),
+        );
         const ROWS: usize = 256;
         let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<Real>)> = (0..n.div_ceil(ROWS))
             .into_par_iter()
             .map_init(
-                || (vec![0.0; n], vec![false; n], Vec::<u32>::new()),
-                |(acc, seen, touched), ci| {
+                || RowAccumulator::new(n),
+                |acc, ci| {
                     let (r0, r1) = (ci * ROWS, ((ci + 1) * ROWS).min(n));
                     let (mut lens, mut idx, mut wts) = (Vec::new(), Vec::new(), Vec::new());
                     for r in r0..r1 {
@@ -106,25 +98,10 @@ impl StencilTable {
                             let m = cols.len();
                             let row = &matrix[k as usize * m..(k as usize + 1) * m];
                             for (&c, &w) in cols.iter().zip(row) {
-                                let cu = c as usize;
-                                if !seen[cu] {
-                                    seen[cu] = true;
-                                    touched.push(c);
-                                }
-                                acc[cu] += w;
+                                acc.add(c, w);
                             }
                         }
-                        touched.sort_unstable();
-                        let before = idx.len();
-                        for &c in touched.iter() {
-                            let cu = c as usize;
-                            idx.push(c);
-                            wts.push(acc[cu]);
-                            acc[cu] = 0.0;
-                            seen[cu] = false;
-                        }
-                        touched.clear();
-                        lens.push(idx.len() - before);
+                        lens.push(acc.finish_row(true, |_| true, &mut idx, &mut wts));
                     }
                     (lens, idx, wts)
                 },

@@ -2,6 +2,7 @@
 //! (refined vertices, limit samples, derivatives). See `StencilTable`.
 
 mod assemble;
+mod csr;
 mod table;
 
 pub use assemble::Elements;

@@ -6,8 +6,9 @@
 
 use rayon::prelude::*;
 
+use super::csr::RowAccumulator;
 use crate::error::{Error, Result};
-use crate::math::{Point3, Real};
+use crate::math::{Point3, Real, group_by_key};
 
 /// A sparse matrix in compressed-row form with `u32` column indices.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -176,26 +177,12 @@ impl StencilTable {
 
     /// The transposed table (`num_cols × num_rows`).
     pub fn transpose(&self) -> StencilTable {
-        let mut counts = vec![0usize; self.num_cols + 1];
-        for &c in &self.indices {
-            counts[c as usize + 1] += 1;
-        }
-        for i in 0..self.num_cols {
-            counts[i + 1] += counts[i];
-        }
-        let offsets = counts.clone();
-        let mut next = counts;
-        let mut indices = vec![0u32; self.num_entries()];
-        let mut weights = vec![0.0; self.num_entries()];
-        for r in 0..self.num_rows() {
+        let entries = (0..self.num_rows()).flat_map(|r| {
             let (c, w) = self.row(r);
-            for (&c, &w) in c.iter().zip(w) {
-                let k = next[c as usize];
-                indices[k] = r as u32;
-                weights[k] = w;
-                next[c as usize] += 1;
-            }
-        }
+            (c.iter().zip(w)).map(move |(&c, &w)| (c as usize, (r as u32, w)))
+        });
+        let (offsets, entries) = group_by_key(self.num_cols, entries);
+        let (indices, weights) = entries.into_iter().unzip();
         StencilTable {
             num_cols: self.num_rows(),
             offsets,
@@ -217,14 +204,13 @@ impl StencilTable {
         }
         let n = self.num_rows();
         let ncols = inner.num_cols;
-        // Per-thread dense accumulator with a list of touched columns (a sparse
-        // accumulator), so each output row costs only its own fill.
+        // A sparse accumulator per thread.
         let rows = chunk_rows(n);
         let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<Real>)> = (0..n.div_ceil(rows))
             .into_par_iter()
             .map_init(
-                || (vec![0.0; ncols], vec![false; ncols], Vec::<u32>::new()),
-                |(acc, seen, touched), ci| {
+                || RowAccumulator::new(ncols),
+                |acc, ci| {
                     let (r0, r1) = (ci * rows, ((ci + 1) * rows).min(n));
                     let mut lens = Vec::with_capacity(r1 - r0);
                     let mut idx = Vec::new();
@@ -234,27 +220,10 @@ impl StencilTable {
                         for (&m, &a) in oc.iter().zip(ow) {
                             let (ic, iw) = inner.row(m as usize);
                             for (&c, &b) in ic.iter().zip(iw) {
-                                let cu = c as usize;
-                                if !seen[cu] {
-                                    seen[cu] = true;
-                                    touched.push(c);
-                                }
-                                acc[cu] += a * b;
+                                acc.add(c, a * b);
                             }
                         }
-                        let before = idx.len();
-                        for &c in touched.iter() {
-                            let cu = c as usize;
-                            let w = acc[cu];
-                            if w.abs() > 1e-300 {
-                                idx.push(c);
-                                wts.push(w);
-                            }
-                            acc[cu] = 0.0;
-                            seen[cu] = false;
-                        }
-                        touched.clear();
-                        lens.push(idx.len() - before);
+                        lens.push(acc.finish_row(false, |w| w.abs() > 1e-300, &mut idx, &mut wts));
                     }
                     (lens, idx, wts)
                 },

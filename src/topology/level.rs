@@ -7,6 +7,7 @@
 //! [`Level::vertex_ring`] for the cyclic order).
 
 use crate::error::{Error, Result};
+use crate::math::{group_by_key, u32_offsets};
 use crate::mesh::PolyMesh;
 
 /// Marker for "no face" in [`Level::edge_faces`].
@@ -155,22 +156,18 @@ impl Level {
     /// Fills `vert_faces` and `vert_edges` from faces and edges (counting sort).
     pub fn build_vertex_adjacency(&mut self) {
         let nv = self.num_vertices;
-        let (offs, items) = invert(nv, self.face_verts.len(), |push| {
-            for f in 0..self.num_faces() {
-                for &v in self.face_vertices(f) {
-                    push(v, f as u32);
-                }
-            }
+        let faces = (0..self.num_faces()).flat_map(|f| {
+            self.face_vertices(f)
+                .iter()
+                .map(move |&v| (v as usize, f as u32))
         });
-        self.vert_face_offsets = offs;
+        let (offs, items) = group_by_key(nv, faces);
+        self.vert_face_offsets = u32_offsets(offs);
         self.vert_faces = items;
-        let (offs, items) = invert(nv, 2 * self.edge_verts.len(), |push| {
-            for (e, ev) in self.edge_verts.iter().enumerate() {
-                push(ev[0], e as u32);
-                push(ev[1], e as u32);
-            }
-        });
-        self.vert_edge_offsets = offs;
+        let edges = (self.edge_verts.iter().enumerate())
+            .flat_map(|(e, ev)| ev.map(|v| (v as usize, e as u32)));
+        let (offs, items) = group_by_key(nv, edges);
+        self.vert_edge_offsets = u32_offsets(offs);
         self.vert_edges = items;
     }
 
@@ -333,21 +330,4 @@ pub fn face_of_corner(face_offsets: &[u32]) -> Vec<u32> {
         out[face_offsets[f] as usize..face_offsets[f + 1] as usize].fill(f as u32);
     }
     out
-}
-
-/// Counting-sort inversion of a relation: `fill` calls `push(key, item)` for
-/// every pair; returns CSR offsets over `n` keys and the items grouped by key.
-fn invert(n: usize, total: usize, fill: impl Fn(&mut dyn FnMut(u32, u32))) -> (Vec<u32>, Vec<u32>) {
-    let mut offs = vec![0u32; n + 1];
-    fill(&mut |k, _| offs[k as usize + 1] += 1);
-    for i in 0..n {
-        offs[i + 1] += offs[i];
-    }
-    let mut next = offs.clone();
-    let mut items = vec![0u32; total];
-    fill(&mut |k, x| {
-        items[next[k as usize] as usize] = x;
-        next[k as usize] += 1;
-    });
-    (offs, items)
 }

@@ -77,8 +77,9 @@ pub struct Closedness {
     pub closed: bool,
 }
 
-/// Measures the layered fraction of `points` (module docs).
-pub fn closedness(points: &[Point3], frame: &PrincipalFrame, threshold: Real) -> Closedness {
+/// At most [`MAX_POINTS`] of `points` (every k-th) relative to the
+/// frame's centroid, the column count for them and their radius.
+fn centred_sample(points: &[Point3], frame: &PrincipalFrame) -> (Vec<Vector3>, usize, Real) {
     let stride = points.len().div_ceil(MAX_POINTS).max(1);
     let sample: Vec<Vector3> = points
         .iter()
@@ -87,6 +88,12 @@ pub fn closedness(points: &[Point3], frame: &PrincipalFrame, threshold: Real) ->
         .collect();
     let columns = column_count(sample.len());
     let radius = sample_radius(&sample);
+    (sample, columns, radius)
+}
+
+/// Measures the layered fraction of `points` (module docs).
+pub fn closedness(points: &[Point3], frame: &PrincipalFrame, threshold: Real) -> Closedness {
+    let (sample, columns, radius) = centred_sample(points, frame);
     let fractions: Vec<((Real, usize), Vector3)> = directions(frame)
         .into_par_iter()
         .map(|d| {
@@ -284,14 +291,7 @@ fn sample_radius(sample: &[Vector3]) -> Real {
 /// cage uses them to notice a flood fill that leaked into the object through
 /// a hole in the scan's coverage.
 pub fn interior_probes(points: &[Point3], frame: &PrincipalFrame) -> Vec<Point3> {
-    let stride = points.len().div_ceil(MAX_POINTS).max(1);
-    let sample: Vec<Vector3> = points
-        .iter()
-        .step_by(stride)
-        .map(|p| p - frame.centroid)
-        .collect();
-    let columns = column_count(sample.len());
-    let radius = sample_radius(&sample);
+    let (sample, columns, radius) = centred_sample(points, frame);
     let mut probes = Vec::new();
     for d in &frame.axes {
         let Some(cols) = Columns::new(&sample, d, columns, radius) else {

@@ -57,20 +57,19 @@ pub fn initial_mesh(points: &PointCloud, params: &InitParams) -> Result<(PolyMes
     let (cleaned, removed, screening) = without_outliers(thinned.as_ref().unwrap_or(points));
     let points = &cleaned;
     let frame = PrincipalFrame::from_points(&points.positions)?;
-    let res = params.resolution;
+    let occ_cage = || {
+        occupancy_cage(
+            &points.positions,
+            &frame,
+            params.resolution,
+            params.max_refinement,
+            params.smoothing_steps,
+        )
+    };
     let (mesh, mut report) = match params.kind {
         InitKind::Closed => closed(&frame, "requested".into()),
         InitKind::Open => open(points, &frame, params, "requested".into()),
-        InitKind::Occupancy => {
-            let occ = occupancy_cage(
-                &points.positions,
-                &frame,
-                res,
-                params.max_refinement,
-                params.smoothing_steps,
-            )?;
-            occupancy(occ, "requested".into())
-        }
+        InitKind::Occupancy => occupancy(occ_cage()?, "requested".into()),
         InitKind::Auto => {
             let c = closedness(&points.positions, &frame, params.closed_threshold);
             let measured = format!(
@@ -85,14 +84,7 @@ pub fn initial_mesh(points: &PointCloud, params: &InitParams) -> Result<(PolyMes
                     format!("{measured}: one range view"),
                 )
             } else {
-                let occ = occupancy_cage(
-                    &points.positions,
-                    &frame,
-                    res,
-                    params.max_refinement,
-                    params.smoothing_steps,
-                )?;
-                occupancy(occ, format!("{measured}: closed"))
+                occupancy(occ_cage()?, format!("{measured}: closed"))
             }
         }
     }?;
