@@ -55,7 +55,7 @@
 //! a sphere, an ellipsoid and a bulb cover 0.76–0.89 (`bun045`: 0.70).
 
 use super::frame::PrincipalFrame;
-use crate::math::{Point3, Real, Vector3, perpendicular_basis};
+use crate::math::{Point3, Real, Vector3, group_by_key, perpendicular_basis};
 use rayon::prelude::*;
 
 /// Largest number of points examined; larger clouds are subsampled.
@@ -171,20 +171,8 @@ impl Columns {
             let j = (((p.dot(&e[1]) - lo[1]) / width) as usize).min(n[1] - 1);
             i + n[0] * j
         };
-        let mut offsets = vec![0usize; n[0] * n[1] + 1];
-        for p in points {
-            offsets[cell(p) + 1] += 1;
-        }
-        for c in 0..n[0] * n[1] {
-            offsets[c + 1] += offsets[c];
-        }
-        let mut depth = vec![0.0; points.len()];
-        let mut fill = offsets.clone();
-        for p in points {
-            let c = cell(p);
-            depth[fill[c]] = p.dot(d);
-            fill[c] += 1;
-        }
+        let (offsets, mut depth) =
+            group_by_key(n[0] * n[1], points.iter().map(|p| (cell(p), p.dot(d))));
         for c in 0..n[0] * n[1] {
             depth[offsets[c]..offsets[c + 1]].sort_unstable_by(|a, b| a.total_cmp(b));
         }

@@ -29,7 +29,7 @@
 use super::footprint::{FootprintStats, footprint};
 use super::frame::PrincipalFrame;
 use crate::error::{Error, Result};
-use crate::math::{Real, Vector3};
+use crate::math::{Real, Vector3, group_by_key};
 use crate::mesh::PointCloud;
 use crate::mesh::PolyMesh;
 
@@ -101,21 +101,8 @@ pub fn height_grid(
     };
     // Counting sort of the points' heights by cell (CSR).
     let local: Vec<Vector3> = cloud.positions.iter().map(|p| frame.local(p)).collect();
-    let mut offsets = vec![0usize; nu * nv + 1];
-    for l in &local {
-        offsets[cell_of(l) + 1] += 1;
-    }
-    for c in 0..nu * nv {
-        offsets[c + 1] += offsets[c];
-    }
+    let (offsets, sorted) = group_by_key(nu * nv, local.iter().map(|l| (cell_of(l), *l)));
     let counts: Vec<usize> = offsets.windows(2).map(|w| w[1] - w[0]).collect();
-    let mut sorted = vec![Vector3::zeros(); local.len()];
-    let mut fill = offsets.clone();
-    for l in &local {
-        let c = cell_of(l);
-        sorted[fill[c]] = *l;
-        fill[c] += 1;
-    }
     let (mask, stats) = footprint(nu, nv, &counts, min_cell_points);
     // Grid vertices used by kept cells, and their median heights.
     let (gu, gv) = (nu + 1, nv + 1);
