@@ -20,7 +20,7 @@ use subdyn::math::{Point3, Real, Vector3};
 use subdyn::mesh::PolyMesh;
 use subdyn::metrics::{
     CompareParams, DistanceStats, Surface, TriangleBvh, area_samples, closest_point_on_triangle,
-    compare, compare_points, distances, percentile, ray_triangle,
+    compare, compare_points, distances, percentile, ray_triangle, self_intersecting_pairs,
 };
 use subdyn::subdivision::RefineOptions;
 
@@ -401,54 +401,55 @@ fn self_intersections_match_brute_force() {
     }
 }
 
-/// The pairs after some vertices moved, found by testing again only the
-/// triangles that moved, are the full search's: on a crumpled grid whose
-/// middle is pushed through the rest, and back (the pairs it had go away),
-/// and on soups with a few triangles moved.
+/// Triangles of very unequal sizes (a few spanning the whole soup over
+/// many small ones, so the grid's cells are made larger), and a mesh
+/// crumpled so far that most of its triangles cross: the grid's pairs are
+/// still the brute force's; bad input is refused.
 #[test]
-fn self_intersections_after_a_local_move_match_the_full_search() {
-    let mut rng = Rng(29);
-    let mut crumpled = grid(24, 0.0);
+fn self_intersections_of_unequal_triangles_and_bad_input() {
+    let mut rng = Rng(31);
+    let soup = random_soup(&mut rng, 600, 0.05);
+    let (mut positions, mut triangles) = (soup.positions().to_vec(), soup.triangles().to_vec());
+    for _ in 0..40 {
+        let base = positions.len() as u32;
+        for _ in 0..3 {
+            positions.push(rng.point(1.5));
+        }
+        triangles.push([base, base + 1, base + 2]);
+    }
+    let mut crumpled = grid(16, 0.0);
     for q in &mut crumpled.positions {
-        *q += 0.3 * (rng.point(1.0) - Point3::origin());
+        *q += 6.0 * (rng.point(1.0) - Point3::origin());
     }
-    let before = TriangleBvh::from_mesh(&crumpled).unwrap();
-    let mut pushed = before.positions().to_vec();
-    let centre = pushed[pushed.len() / 2];
-    let mut moved = 0;
-    for q in &mut pushed {
-        if (*q - centre).norm() < 2.5 {
-            q.x += 2.0;
-            q.z += 0.2;
-            moved += 1;
-        }
+    for bvh in [
+        TriangleBvh::new(positions, triangles).unwrap(),
+        TriangleBvh::from_mesh(&crumpled).unwrap(),
+    ] {
+        let want = brute_self_intersections(&bvh);
+        assert!(
+            want.len() >= 50,
+            "{} pairs: the case must intersect",
+            want.len()
+        );
+        assert_eq!(
+            self_intersecting_pairs(bvh.positions(), bvh.triangles()).unwrap(),
+            want
+        );
     }
-    let after = TriangleBvh::new(pushed.clone(), before.triangles().to_vec()).unwrap();
-    let (old, new) = (before.self_intersections(), after.self_intersections());
+    let p = [
+        Point3::origin(),
+        Point3::new(1.0, 0.0, 0.0),
+        Point3::new(0.0, 1.0, 0.0),
+    ];
+    let err = self_intersecting_pairs(&p, &[[0, 1, 3]]).unwrap_err();
+    assert!(err.to_string().contains("refers to vertex 3"), "{err}");
+    let nan = [p[0], p[1], Point3::new(Real::NAN, 0.0, 0.0)];
+    assert!(self_intersecting_pairs(&nan, &[[0, 1, 2]]).is_err());
     assert!(
-        moved > 5 && moved < pushed.len() / 4,
-        "{moved} vertices moved"
-    );
-    assert_ne!(old, new, "the move must change the pairs");
-    assert_eq!(before.self_intersections_moved(&old, &pushed).unwrap(), new);
-    assert_eq!(
-        after
-            .self_intersections_moved(&new, before.positions())
-            .unwrap(),
-        old
-    );
-    for (n, size) in [(400, 0.2), (1500, 0.08)] {
-        let soup = random_soup(&mut rng, n, size);
-        let pairs = soup.self_intersections();
-        let mut p = soup.positions().to_vec();
-        for t in soup.triangles().iter().step_by(7) {
-            p[t[0] as usize] += rng.point(size).coords;
-        }
-        let want = TriangleBvh::new(p.clone(), soup.triangles().to_vec())
+        self_intersecting_pairs(&p, &[[0, 1, 2]])
             .unwrap()
-            .self_intersections();
-        assert_eq!(soup.self_intersections_moved(&pairs, &p).unwrap(), want);
-    }
+            .is_empty()
+    );
 }
 
 #[test]

@@ -45,7 +45,7 @@ use crate::error::Result;
 use crate::limit::{PatchTable, Tessellation};
 use crate::math::{Point3, Real, Vector3, bounding_box, polygon_folds};
 use crate::mesh::PolyMesh;
-use crate::metrics::TriangleBvh;
+use crate::metrics::self_intersecting_pairs;
 use crate::subdivision::Refiner;
 use crate::topology::{UnionFind, face_of_corner};
 
@@ -229,7 +229,7 @@ pub fn assess(
 
 /// The limit surface tessellated `rate × rate` per tile ([`tessellate`]),
 /// fan-triangulated, and its self-intersecting triangle pairs
-/// ([`TriangleBvh::self_intersections`]).
+/// ([`self_intersecting_pairs`]).
 pub struct SelfIntersections {
     /// Tessellation vertices.
     pub positions: Vec<Point3>,
@@ -241,16 +241,15 @@ pub struct SelfIntersections {
     pub pairs: Vec<[u32; 2]>,
     /// The control points checked.
     control: Vec<Point3>,
-    /// The first check ([`of`](Self::of)), which [`moved`](Self::moved)
-    /// updates.
+    /// What [`moved`](Self::moved) reuses of the first check
+    /// ([`of`](Self::of)).
     first: Arc<FirstCheck>,
 }
 
-/// What [`SelfIntersections::moved`] needs of the first check: its
-/// hierarchy and pairs, the tessellation's topology and the patch table.
+/// What [`SelfIntersections::moved`] reuses of the first check: the
+/// tessellation, its triangles and the patch table.
 struct FirstCheck {
-    bvh: TriangleBvh,
-    pairs: Vec<[u32; 2]>,
+    triangles: Vec<[u32; 3]>,
     plan: Tessellation,
     table: Mutex<PatchTable>,
 }
@@ -284,17 +283,15 @@ impl SelfIntersections {
                 face.push(f);
             }
         }
-        let bvh = TriangleBvh::new(mesh.positions, triangles)?;
-        let pairs = bvh.self_intersections();
+        let pairs = self_intersecting_pairs(&mesh.positions, &triangles)?;
         Ok(SelfIntersections {
-            positions: bvh.positions().to_vec(),
+            positions: mesh.positions,
             normals,
             face,
-            pairs: pairs.clone(),
+            pairs,
             control: positions.to_vec(),
             first: Arc::new(FirstCheck {
-                bvh,
-                pairs,
+                triangles,
                 plan,
                 table: Mutex::new(table),
             }),
@@ -304,8 +301,7 @@ impl SelfIntersections {
     /// The same check after the control points moved to `positions`: the
     /// pairs [`of`](Self::of) would give. Only the faces whose limit surface
     /// moved (those with a vertex sharing a face with a moved control point)
-    /// are evaluated again, and only the triangles that moved are tested
-    /// again ([`TriangleBvh::self_intersections_moved`]).
+    /// are evaluated again.
     pub fn moved(&self, refiner: &Refiner, positions: &[Point3]) -> Result<Self> {
         let level = &refiner.level;
         let moved: Vec<bool> = self
@@ -335,7 +331,7 @@ impl SelfIntersections {
             .plan
             .evaluate(&table, Some((&faces, &self.positions, &self.normals)))?;
         Ok(SelfIntersections {
-            pairs: first.bvh.self_intersections_moved(&first.pairs, &points)?,
+            pairs: self_intersecting_pairs(&points, &first.triangles)?,
             positions: points,
             normals,
             face: self.face.clone(),
@@ -346,7 +342,7 @@ impl SelfIntersections {
 
     /// Tessellation triangles (indices into `positions`).
     pub fn triangles(&self) -> &[[u32; 3]] {
-        self.first.bvh.triangles()
+        &self.first.triangles
     }
 
     /// Per control face of the mesh (`num_faces` of them): whether a

@@ -3,9 +3,11 @@
 //! distances, normal consistency — on meshes, point clouds and Catmull-Clark
 //! limit surfaces.
 //!
-//! - [`TriangleBvh`] (`bvh`, `bvh_build`, `bvh_collapse`, `bvh_closest`, `bvh_ray`): closest
-//!   point and first ray hit;
+//! - [`TriangleBvh`] (`bvh`, `bvh_build`, `bvh_collapse`, `bvh_closest`, `bvh_ray`,
+//!   `bvh_segment`): closest point, first ray hit, segment hits;
 //!   leaf tests in `triangle` ([`closest_point_on_triangle`], [`ray_triangle`]).
+//! - [`self_intersecting_pairs`] (`self_intersections`): the pairs of a
+//!   mesh's triangles that cross, on a uniform grid (no hierarchy).
 //! - [`distances`] (`batch`): many queries in parallel.
 //! - [`DistanceStats`], [`percentile`] (`stats`).
 //! - [`area_samples`] (`sampling`): area-weighted points on triangles.
@@ -22,6 +24,7 @@ mod bvh_ray;
 mod bvh_segment;
 mod compare;
 mod sampling;
+mod self_intersections;
 mod stats;
 mod surface;
 mod triangle;
@@ -30,6 +33,7 @@ pub use batch::distances;
 pub use bvh::{Hit, Nearest, TriangleBvh};
 pub use compare::{CompareParams, Comparison, OneSided, compare, compare_points};
 pub use sampling::area_samples;
+pub use self_intersections::self_intersecting_pairs;
 pub use stats::{DistanceStats, percentile};
 pub use surface::{Surface, SurfacePoint};
 pub use triangle::{
