@@ -14,18 +14,19 @@
 //! The candidates come from a uniform grid (the cell lists of collision
 //! detection; Teschner et al., "Optimized spatial hashing for collision
 //! detection of deformable objects", VMV 2003, store them hashed, here they
-//! are sorted): every triangle's box goes into the cells it overlaps, and
-//! the triangles of a cell are paired. A pair whose boxes overlap is tested
-//! only in the cell holding the low corner of the overlap, which both boxes
-//! occupy: along each axis that is the later of the two boxes' first
-//! cells, so each entry carries which axes its box starts on, and two
-//! entries are paired only when together they start on all three. Each
-//! pair is so met once, with no set of pairs to merge. The cell is the
-//! median of the triangles' largest box sides (a tessellation's triangles
-//! are alike in size), doubled while the entries would pass
-//! [`MAX_ENTRIES_PER_TRIANGLE`] per triangle. `O(n log n)` (one sort) for
-//! triangles of similar size, no tree to build; cells run in parallel and
-//! the pairs are sorted, so the result does not depend on the thread count.
+//! are sorted by cell with a radix sort): every triangle's box goes into the
+//! cells it overlaps, and the triangles of a cell are paired. A pair whose
+//! boxes overlap is tested only in the cell holding the low corner of the
+//! overlap, which both boxes occupy: along each axis that is the later of
+//! the two boxes' first cells, so each triangle of a cell is marked with
+//! the axes its box starts on there, and two are paired only when together
+//! they start on all three. Each pair is so met once, with no set of pairs
+//! to merge. The cell side is [`CELL_SIDE`] × the median of the triangles'
+//! largest box sides (a tessellation's triangles are alike in size),
+//! doubled while the entries would pass [`MAX_ENTRIES_PER_TRIANGLE`] per
+//! triangle. `O(n)` for triangles of similar size, no tree to build; cells
+//! run in parallel and the pairs are sorted, so the result does not depend
+//! on the thread count.
 
 use rayon::prelude::*;
 
@@ -123,20 +124,20 @@ pub(crate) fn pairs_of(positions: &[Point3], triangles: &[[u32; 3]]) -> Vec<[u32
         })
         .collect();
     let grid = Grid::new(&boxes, all.lo.map(|x| x - margin));
-    // (cell, triangle, the axes its box starts on in that cell) of every
-    // cell of every triangle, in triangle order, then sorted by cell by
-    // stable counting sorts on `DIGIT_BITS` bits at a time (LSD radix
-    // sort): each cell's entries in a run, in triangle order.
-    let mut entries: Vec<Entry> = Vec::with_capacity(grid.entries);
+    // (cell, triangle) of every cell of every triangle, packed in a `u64`
+    // (the cell's key above the triangle), in triangle order, then sorted
+    // by cell by stable counting sorts on `DIGIT_BITS` bits at a time (LSD
+    // radix sort): each cell's entries in a run, in triangle order.
+    let mut entries: Vec<u64> = Vec::with_capacity(grid.entries);
     for (t, b) in boxes.iter().enumerate() {
         grid.push_entries(b, t as u32, &mut entries);
     }
-    for shift in (0..grid.key_bits).step_by(DIGIT_BITS as usize) {
-        let digit = |e: &Entry| ((e.cell >> shift) & ((1 << DIGIT_BITS) - 1)) as usize;
-        entries = group_by_key(1 << DIGIT_BITS, entries.iter().map(|e| (digit(e), *e))).1;
+    for shift in (32..32 + grid.key_bits).step_by(DIGIT_BITS as usize) {
+        let digit = |e: u64| ((e >> shift) & ((1 << DIGIT_BITS) - 1)) as usize;
+        entries = group_by_key(1 << DIGIT_BITS, entries.iter().map(|&e| (digit(e), e))).1;
     }
     let mut runs: Vec<usize> = (0..entries.len())
-        .filter(|&i| i == 0 || entries[i].cell != entries[i - 1].cell)
+        .filter(|&i| i == 0 || entries[i] >> 32 != entries[i - 1] >> 32)
         .collect();
     runs.push(entries.len());
     let planes: Vec<Plane> = (0..triangles.len() as u32)
@@ -146,15 +147,20 @@ pub(crate) fn pairs_of(positions: &[Point3], triangles: &[[u32; 3]]) -> Vec<[u32
     let mut pairs: Vec<[u32; 2]> = runs
         .par_windows(2)
         .flat_map_iter(|run| {
-            let here = &entries[run[0]..run[1]];
+            let cell = grid.cell(entries[run[0]] >> 32);
+            // Each triangle with the axes its box starts on in this cell.
+            let here: Vec<(u32, u8)> = entries[run[0]..run[1]]
+                .iter()
+                .map(|&e| (e as u32, grid.starts(&boxes[e as u32 as usize], cell)))
+                .collect();
             let mut out = Vec::new();
-            for (i, e) in here.iter().enumerate() {
-                let (s, ts, a) = (e.tri, &triangles[e.tri as usize], &boxes[e.tri as usize]);
-                for f in &here[i + 1..] {
-                    if e.starts | f.starts != ALL_AXES {
+            for (i, &(s, s_starts)) in here.iter().enumerate() {
+                let (ts, a) = (&triangles[s as usize], &boxes[s as usize]);
+                for &(t, t_starts) in &here[i + 1..] {
+                    if s_starts | t_starts != ALL_AXES {
                         continue;
                     }
-                    let (t, tt, b) = (f.tri, &triangles[f.tri as usize], &boxes[f.tri as usize]);
+                    let (tt, b) = (&triangles[t as usize], &boxes[t as usize]);
                     if (0..3).any(|k| a.lo[k] > b.hi[k] || b.lo[k] > a.hi[k])
                         || ts.iter().any(|v| tt.contains(v))
                     {
@@ -177,19 +183,14 @@ pub(crate) fn pairs_of(positions: &[Point3], triangles: &[[u32; 3]]) -> Vec<[u32
 }
 
 /// Bits of the cell key sorted per counting-sort pass.
-const DIGIT_BITS: u32 = 11;
+const DIGIT_BITS: u32 = 13;
 
-/// One cell of one triangle's box.
-#[derive(Clone, Copy, Default)]
-struct Entry {
-    /// The cell's coordinates, packed ([`Grid::push_entries`]).
-    cell: u64,
-    tri: u32,
-    /// Bit `k`: the box's first cell along axis `k` is this one.
-    starts: u8,
-}
+/// The cell side in medians of the triangles' largest box sides: larger
+/// cells hold more triangles to pair, smaller ones more entries to sort
+/// (2 was the fastest of 1, 2, 3 and 4 on the tessellations of fits).
+const CELL_SIDE: Real = 2.0;
 
-/// [`Entry::starts`] of a box's first cell.
+/// [`Grid::starts`] of a box's first cell.
 const ALL_AXES: u8 = 0b111;
 
 /// A triangle's plane, for the early rejection of a pair whose one
@@ -249,7 +250,7 @@ fn crosses(positions: &[Point3], s: &[u32; 3], [p, q, r]: [Point3; 3]) -> bool {
 }
 
 /// The uniform grid: cells of side `h` from `origin`, `bits[k]` bits of
-/// cell index along axis `k` in an [`Entry::cell`] key.
+/// cell index along axis `k` in a cell's key.
 struct Grid {
     origin: [Real; 3],
     h: Real,
@@ -261,8 +262,8 @@ struct Grid {
 }
 
 impl Grid {
-    /// The grid for `boxes`, within `origin` and `hi` (module docs), with
-    /// keys of at most 63 bits.
+    /// The grid for `boxes`, from `origin` (module docs), with cell keys of
+    /// at most 32 bits.
     fn new(boxes: &[Aabb], origin: [Real; 3]) -> Grid {
         let mut sides: Vec<Real> = boxes
             .iter()
@@ -275,7 +276,7 @@ impl Grid {
         });
         let mut grid = Grid {
             origin,
-            h: median,
+            h: CELL_SIDE * median,
             bits: [0; 3],
             key_bits: 0,
             entries: 0,
@@ -293,7 +294,7 @@ impl Grid {
                         .product::<u64>()
                 })
                 .sum::<u64>();
-            if grid.key_bits <= 63 && entries <= limit {
+            if grid.key_bits <= 32 && entries <= limit {
                 grid.entries = entries as usize;
                 return grid;
             }
@@ -311,20 +312,34 @@ impl Grid {
         [0, 1, 2].map(|k| self.index(b.lo[k], k)..self.index(b.hi[k], k) + 1)
     }
 
-    /// Appends the entries of triangle `tri` with box `b` to `out`.
-    fn push_entries(&self, b: &Aabb, tri: u32, out: &mut Vec<Entry>) {
+    /// Appends the entries of triangle `tri` with box `b` to `out`: the
+    /// key of each cell it overlaps above `tri`.
+    fn push_entries(&self, b: &Aabb, tri: u32, out: &mut Vec<u64>) {
         let [x, y, z] = self.span(b);
-        let start = |i: u64, s: u64, axis: u8| u8::from(i == s) << axis;
-        for i in x.clone() {
+        for i in x {
             for j in y.clone() {
                 for k in z.clone() {
-                    out.push(Entry {
-                        cell: (((i << self.bits[1]) | j) << self.bits[2]) | k,
-                        tri,
-                        starts: start(i, x.start, 0) | start(j, y.start, 1) | start(k, z.start, 2),
-                    });
+                    let key = (((i << self.bits[1]) | j) << self.bits[2]) | k;
+                    out.push((key << 32) | u64::from(tri));
                 }
             }
         }
+    }
+
+    /// The cell of a key.
+    fn cell(&self, key: u64) -> [u64; 3] {
+        let mask = |bits: u32| (1u64 << bits) - 1;
+        [
+            key >> (self.bits[1] + self.bits[2]),
+            (key >> self.bits[2]) & mask(self.bits[1]),
+            key & mask(self.bits[2]),
+        ]
+    }
+
+    /// Bit `k` set: the box `b`'s first cell along axis `k` is `cell`'s.
+    fn starts(&self, b: &Aabb, cell: [u64; 3]) -> u8 {
+        (0..3)
+            .filter(|&k| self.index(b.lo[k], k) == cell[k])
+            .fold(0, |m, k| m | 1 << k)
     }
 }
