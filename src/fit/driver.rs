@@ -379,8 +379,13 @@ pub fn fit_screened_cloud(
             if untangle_round >= params.untangle_rounds {
                 break fitted;
             }
-            let crossing =
-                SelfIntersections::of(&refiner, &p, UNTANGLE_CHECK_RATE)?.faces(mesh.num_faces());
+            let crossing = SelfIntersections::with_quadtrees(
+                &refiner,
+                &p,
+                UNTANGLE_CHECK_RATE,
+                quadtrees.clone(),
+            )?
+            .faces(mesh.num_faces());
             if !crossing.contains(&true) {
                 break fitted;
             }
@@ -716,8 +721,12 @@ pub fn fit_screened_cloud(
         mesh = next;
         creases = next_creases;
     };
-    let (crossings, final_untangling) =
-        untangle_after_fit(&mut mesh, &creases, params.final_untangle_rounds)?;
+    let (crossings, final_untangling) = untangle_after_fit(
+        &mut mesh,
+        &creases,
+        params.final_untangle_rounds,
+        &quadtrees,
+    )?;
     let kept_dist: Vec<Real> = data_index.iter().map(|&i| final_dist[i]).collect();
     let quality = assess(&mesh, crossings, &data, &data_tree, &kept_dist, diameter)?;
     Ok(FitResult {
@@ -776,10 +785,12 @@ fn untangle_after_fit(
     mesh: &mut PolyMesh,
     creases: &[Crease],
     max_rounds: usize,
+    quadtrees: &QuadtreeCache,
 ) -> Result<(SelfIntersections, Untangling)> {
     let refiner = Refiner::new(mesh, &crease_options(creases))?;
     let start = mesh.positions.clone();
-    let mut best = SelfIntersections::of(&refiner, &start, CHECK_RATE)?;
+    let mut best =
+        SelfIntersections::with_quadtrees(&refiner, &start, CHECK_RATE, quadtrees.clone())?;
     let mut done = Untangling {
         pairs_before: best.pairs.len(),
         ..Default::default()

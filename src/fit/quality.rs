@@ -42,7 +42,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::error::Result;
-use crate::limit::{PatchTable, Tessellation};
+use crate::limit::{PatchTable, QuadtreeCache, Tessellation};
 use crate::math::{Point3, Real, Vector3, bounding_box, polygon_folds};
 use crate::mesh::PolyMesh;
 use crate::metrics::self_intersecting_pairs;
@@ -258,8 +258,20 @@ impl SelfIntersections {
     /// The tessellation of the limit surface of `refiner`'s mesh with
     /// control points `positions`, and its self-intersections.
     pub fn of(refiner: &Refiner, positions: &[Point3], rate: usize) -> Result<Self> {
+        Self::with_quadtrees(refiner, positions, rate, QuadtreeCache::default())
+    }
+
+    /// [`of`](Self::of) with the quadtrees of irregular patches looked up
+    /// in and added to `quadtrees` (a fit's checks share the fit's cache:
+    /// most local structures recur from check to check and level to level).
+    pub fn with_quadtrees(
+        refiner: &Refiner,
+        positions: &[Point3],
+        rate: usize,
+        quadtrees: QuadtreeCache,
+    ) -> Result<Self> {
         let plan = Tessellation::new(refiner, rate)?;
-        let table = PatchTable::new(refiner, positions, 1)?;
+        let table = PatchTable::with_quadtrees(refiner, positions, 1, quadtrees)?;
         let (points, normals) = plan.evaluate(&table, None)?;
         let mesh = plan.mesh(points)?;
         let level = &refiner.level;
