@@ -12,7 +12,7 @@ use crate::mesh::PolyMesh;
 
 use super::bvh_build::{Aabb, MAX_DEPTH, build};
 use super::bvh_collapse::{Node4, collapse};
-use super::triangle::{PreparedTriangle, triangle_normal};
+use super::triangle::{PreparedTriangle, check_triangles, triangle_normal};
 
 /// The closest point of a [`TriangleBvh`] to a query.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -115,25 +115,7 @@ impl TriangleBvh {
         if triangles.is_empty() {
             return Err(Error::Input("no triangles to build a BVH over".into()));
         }
-        if triangles.len() > u32::MAX as usize {
-            return Err(Error::Input(format!(
-                "{} triangles: at most {} are supported",
-                triangles.len(),
-                u32::MAX
-            )));
-        }
-        crate::mesh::check_finite(&positions)?;
-        let n = positions.len();
-        if let Some((t, tri)) = triangles
-            .iter()
-            .enumerate()
-            .find(|(_, tri)| tri.iter().any(|&v| v as usize >= n))
-        {
-            return Err(Error::Input(format!(
-                "triangle {t} refers to vertex {}, but there are only {n} vertices",
-                tri.iter().copied().max().unwrap_or(0)
-            )));
-        }
+        check_triangles(&positions, &triangles)?;
         let corners = |tri: &[u32; 3]| tri.map(|v| positions[v as usize]);
         let boxes: Vec<Aabb> = triangles
             .iter()

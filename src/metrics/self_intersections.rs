@@ -30,12 +30,12 @@
 
 use rayon::prelude::*;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::math::{Point3, Real, Vector3, group_by_key};
 
 use super::bvh_build::Aabb;
 
-use super::triangle::ray_triangle;
+use super::triangle::{check_triangles, ray_triangle};
 
 /// Cell entries per triangle, on average, above which the cells are made
 /// twice as large (bounds the memory on meshes of very unequal triangles).
@@ -63,25 +63,7 @@ pub fn self_intersecting_pairs(
     positions: &[Point3],
     triangles: &[[u32; 3]],
 ) -> Result<Vec<[u32; 2]>> {
-    let n = positions.len();
-    if let Some((t, tri)) = triangles
-        .iter()
-        .enumerate()
-        .find(|(_, tri)| tri.iter().any(|&v| v as usize >= n))
-    {
-        return Err(Error::Input(format!(
-            "triangle {t} refers to vertex {}, but there are only {n} vertices",
-            tri.iter().copied().max().unwrap_or(0)
-        )));
-    }
-    if triangles.len() > u32::MAX as usize {
-        return Err(Error::Input(format!(
-            "{} triangles: at most {} are supported",
-            triangles.len(),
-            u32::MAX
-        )));
-    }
-    crate::mesh::check_finite(positions)?;
+    check_triangles(positions, triangles)?;
     Ok(pairs_of(positions, triangles))
 }
 

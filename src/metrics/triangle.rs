@@ -1,6 +1,7 @@
 //! Point–triangle and ray–triangle primitives: the exact leaf tests of the
 //! [`TriangleBvh`](super::TriangleBvh).
 
+use crate::error::{Error, Result};
 use crate::math::{Point3, Real, Vector3};
 
 /// Closest point to `p` on the triangle `abc` (boundary and interior), with
@@ -219,4 +220,30 @@ pub fn triangle_normal(a: Point3, b: Point3, c: Point3) -> Vector3 {
         .cross(&(c - a))
         .try_normalize(0.0)
         .unwrap_or_else(Vector3::zeros)
+}
+
+/// Checks triangles (indices into `positions`) for the structures built
+/// over them: at most `u32::MAX` triangles, finite positions, every index
+/// in range.
+pub(crate) fn check_triangles(positions: &[Point3], triangles: &[[u32; 3]]) -> Result<()> {
+    if triangles.len() > u32::MAX as usize {
+        return Err(Error::Input(format!(
+            "{} triangles: at most {} are supported",
+            triangles.len(),
+            u32::MAX
+        )));
+    }
+    crate::mesh::check_finite(positions)?;
+    let n = positions.len();
+    if let Some((t, tri)) = triangles
+        .iter()
+        .enumerate()
+        .find(|(_, tri)| tri.iter().any(|&v| v as usize >= n))
+    {
+        return Err(Error::Input(format!(
+            "triangle {t} refers to vertex {}, but there are only {n} vertices",
+            tri.iter().copied().max().unwrap_or(0)
+        )));
+    }
+    Ok(())
 }
