@@ -267,16 +267,19 @@ impl Grid {
         loop {
             grid.bits = [0, 1, 2].map(|k| u64::BITS - grid.index(hi[k], k).leading_zeros());
             grid.key_bits = grid.bits.iter().sum();
-            let entries = boxes
-                .par_iter()
-                .map(|b| {
-                    grid.span(b)
-                        .iter()
-                        .map(|s| s.end - s.start)
-                        .product::<u64>()
-                })
-                .sum::<u64>();
-            if grid.key_bits <= 32 && entries <= limit {
+            // Within 32 bits of key, no box has more than 2³² cells.
+            let entries = (grid.key_bits <= 32).then(|| {
+                boxes
+                    .par_iter()
+                    .map(|b| {
+                        grid.span(b)
+                            .iter()
+                            .map(|s| s.end - s.start)
+                            .product::<u64>()
+                    })
+                    .sum::<u64>()
+            });
+            if let Some(entries) = entries.filter(|&e| e <= limit) {
                 grid.entries = entries as usize;
                 return grid;
             }
