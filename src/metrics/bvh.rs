@@ -12,6 +12,7 @@ use crate::mesh::PolyMesh;
 
 use super::bvh_build::{Aabb, MAX_DEPTH, build};
 use super::bvh_collapse::{Node4, collapse};
+use super::self_intersections::pairs_of;
 use super::triangle::{PreparedTriangle, check_triangles, triangle_normal};
 
 /// The closest point of a [`TriangleBvh`] to a query.
@@ -181,6 +182,14 @@ impl TriangleBvh {
     /// Number of (4-wide) nodes of the hierarchy.
     pub fn num_nodes(&self) -> usize {
         self.nodes.len()
+    }
+
+    /// The pairs `[s, t]` (`s < t`, sorted) of the triangles that share no
+    /// vertex index and intersect:
+    /// [`self_intersecting_pairs`](super::self_intersecting_pairs) of this
+    /// hierarchy's triangles (found on a grid, not with the hierarchy).
+    pub fn self_intersections(&self) -> Vec<[u32; 2]> {
+        pairs_of(&self.positions, &self.triangles)
     }
 }
 

@@ -106,7 +106,7 @@ impl TriangleBvh {
 /// far bound is widened by `1 + 2γ₃` (Ize 2013) so rounding never culls a
 /// box the ray touches.
 #[inline]
-pub(super) fn slab(
+fn slab(
     lo: &[Real; 3],
     hi: &[Real; 3],
     o: &Vector3,

@@ -3,8 +3,8 @@
 //! distances, normal consistency — on meshes, point clouds and Catmull-Clark
 //! limit surfaces.
 //!
-//! - [`TriangleBvh`] (`bvh`, `bvh_build`, `bvh_collapse`, `bvh_closest`, `bvh_ray`,
-//!   `bvh_segment`): closest point, first ray hit, segment hits;
+//! - [`TriangleBvh`] (`bvh`, `bvh_build`, `bvh_collapse`, `bvh_closest`, `bvh_ray`): closest
+//!   point and first ray hit;
 //!   leaf tests in `triangle` ([`closest_point_on_triangle`], [`ray_triangle`]).
 //! - [`self_intersecting_pairs`] (`self_intersections`): the pairs of a
 //!   mesh's triangles that cross, on a uniform grid (no hierarchy).
@@ -21,7 +21,6 @@ mod bvh_build;
 mod bvh_closest;
 mod bvh_collapse;
 mod bvh_ray;
-mod bvh_segment;
 mod compare;
 mod sampling;
 mod self_intersections;
