@@ -120,13 +120,7 @@ impl TriangleBvh {
         let corners = |tri: &[u32; 3]| tri.map(|v| positions[v as usize]);
         let boxes: Vec<Aabb> = triangles
             .iter()
-            .map(|tri| {
-                let mut b = Aabb::EMPTY;
-                for p in corners(tri) {
-                    b.grow(&[p.x, p.y, p.z]);
-                }
-                b
-            })
+            .map(|tri| Aabb::of_triangle(corners(tri)))
             .collect();
         let (binary, leaf_ids) = build(&boxes);
         let root = &binary[0].bounds;

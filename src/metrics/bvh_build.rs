@@ -46,6 +46,20 @@ impl Aabb {
         }
     }
 
+    /// The box of a triangle's corners.
+    pub fn of_triangle(corners: [crate::math::Point3; 3]) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for p in corners {
+            b.grow(&[p.x, p.y, p.z]);
+        }
+        b
+    }
+
+    /// The largest side (0 for an empty box).
+    pub fn largest_side(&self) -> Real {
+        (0..3).map(|k| self.hi[k] - self.lo[k]).fold(0.0, Real::max)
+    }
+
     pub fn merge(&mut self, o: &Aabb) {
         for k in 0..3 {
             self.lo[k] = self.lo[k].min(o.lo[k]);

@@ -76,13 +76,7 @@ pub(crate) fn pairs_of(positions: &[Point3], triangles: &[[u32; 3]]) -> Vec<[u32
     let corners = |t: u32| triangles[t as usize].map(|v| positions[v as usize]);
     let exact: Vec<Aabb> = (0..triangles.len() as u32)
         .into_par_iter()
-        .map(|t| {
-            let mut b = Aabb::EMPTY;
-            for p in corners(t) {
-                b.grow(&[p.x, p.y, p.z]);
-            }
-            b
-        })
+        .map(|t| Aabb::of_triangle(corners(t)))
         .collect();
     let all = exact.par_iter().copied().reduce(
         || Aabb::EMPTY,
@@ -124,7 +118,7 @@ pub(crate) fn pairs_of(positions: &[Point3], triangles: &[[u32; 3]]) -> Vec<[u32
     runs.push(entries.len());
     let planes: Vec<Plane> = (0..triangles.len() as u32)
         .into_par_iter()
-        .map(|t| Plane::of(corners(t)))
+        .map(|t| Plane::of(corners(t), exact[t as usize].largest_side()))
         .collect();
     let mut pairs: Vec<[u32; 2]> = runs
         .par_windows(2)
@@ -194,11 +188,10 @@ struct Plane {
 const APART: Real = 1e-6;
 
 impl Plane {
-    fn of([a, b, c]: [Point3; 3]) -> Plane {
+    /// The plane of the triangle with corners `a`, `b`, `c` and largest
+    /// box side `size`.
+    fn of([a, b, c]: [Point3; 3], size: Real) -> Plane {
         let normal = (b - a).cross(&(c - a));
-        let size = (0..3)
-            .map(|k| a[k].max(b[k]).max(c[k]) - a[k].min(b[k]).min(c[k]))
-            .fold(0.0, Real::max);
         Plane {
             normal,
             offset: normal.dot(&a.coords),
@@ -247,10 +240,7 @@ impl Grid {
     /// The grid for `boxes`, from `origin` (module docs), with cell keys of
     /// at most 32 bits.
     fn new(boxes: &[Aabb], origin: [Real; 3]) -> Grid {
-        let mut sides: Vec<Real> = boxes
-            .iter()
-            .map(|b| (0..3).map(|k| b.hi[k] - b.lo[k]).fold(0.0, Real::max))
-            .collect();
+        let mut sides: Vec<Real> = boxes.iter().map(Aabb::largest_side).collect();
         let mid = sides.len() / 2;
         let (_, &mut median, _) = sides.select_nth_unstable_by(mid, Real::total_cmp);
         let hi = boxes.iter().fold([Real::NEG_INFINITY; 3], |m, b| {
