@@ -1,18 +1,153 @@
-//! The rules of the multilevel loop that the point-cloud fit and the
-//! volume recovery share (Qin, Mandal, Vemuri 1998, §6: the model settles
-//! at a level, and is subdivided while its error is above the tolerance).
+//! The multilevel loop that the point-cloud fit and the volume recovery
+//! share (Qin, Mandal, Vemuri 1998, §6: the model settles at a level, and
+//! is subdivided while its error is above the tolerance), and its rules.
+//!
+//! [`run_levels`] owns the loop: it checks each level's memory, builds its
+//! [`Refiner`], lets the force source ([`LevelFit`]: the fit's data springs,
+//! the recovery's image forces) set the level up and settle it, applies the
+//! shared stop rules ([`stop_after_level`]) to what the source measured, and
+//! refines, uniformly or by splitting the faces the source ranks
+//! ([`split_within`]), carrying the creases.
 
 use super::crease_options;
 use super::creases::{Crease, refined_creases};
+use super::system::check_level_memory;
 use crate::error::Result;
 use crate::limit::{interpolate_limit_points, limit_stencil};
 use crate::math::{Point3, Real};
 use crate::mesh::PolyMesh;
-use crate::subdivision::{Hierarchy, LocalRefinement, close_marks, refine_marked};
+use crate::subdivision::{Hierarchy, LocalRefinement, Refiner, close_marks, refine_marked};
 
 /// Iterations of progressive interpolation that put a locally refined
 /// level's surface on its parent's.
 const LIMIT_ITERATIONS: usize = 60;
+
+/// What a force source says after settling a level ([`LevelFit::fit_level`]).
+pub(crate) enum Verdict {
+    /// Fit the same level again: the source changed the mesh or its
+    /// creases (fitted again with creases found, or refined otherwise).
+    Again,
+    /// Stop here: converged or not, and why.
+    Stop(bool, String),
+    /// The level is measured: the shared stop rules decide
+    /// ([`stop_after_level`]'s `met`, `gain` and `measure`).
+    Judge {
+        met: Option<String>,
+        gain: Option<(Real, Real)>,
+        measure: String,
+    },
+}
+
+/// How the source wants the level refined ([`LevelFit::refinement`]).
+pub(crate) enum Refine {
+    /// Every face split.
+    Uniform,
+    /// The faces of `rank` split, worst first, within `cap` control points
+    /// ([`split_within`]).
+    Adaptive { rank: Vec<usize>, cap: Real },
+    /// No finer level: converged or not, and why.
+    Stop(bool, String),
+}
+
+/// The next level [`run_levels`] made, shown to the source before it is
+/// fitted ([`LevelFit::refined`]).
+pub(crate) enum Refined<'a> {
+    /// One uniform refinement of the level.
+    Uniform,
+    /// The split faces.
+    Adaptive(&'a Split),
+}
+
+/// A force source of the multilevel loop.
+pub(crate) trait LevelFit {
+    /// The number of the next level to fit (the levels kept so far).
+    fn level(&self) -> usize;
+
+    /// Sets up the level of `mesh` (refined by `refiner`, with `creases`),
+    /// settles it and measures it: `mesh` ends with the fitted positions (or
+    /// whatever mesh the verdict stands for).
+    fn fit_level(
+        &mut self,
+        level: usize,
+        refiner: &Refiner,
+        mesh: &mut PolyMesh,
+        creases: &mut Vec<Crease>,
+    ) -> Result<Verdict>;
+
+    /// How the level just fitted is refined, once the stop rules go on.
+    fn refinement(&mut self, level: usize, mesh: &PolyMesh) -> Result<Refine>;
+
+    /// `next` (with `next_vertices` control points) refines `mesh` (with
+    /// `creases`), the level just fitted: `Some` stops before fitting it
+    /// (a budget passed).
+    fn refined(
+        &mut self,
+        level: usize,
+        mesh: &PolyMesh,
+        creases: &[Crease],
+        next: Refined,
+        next_vertices: usize,
+    ) -> Result<Option<(bool, String)>>;
+}
+
+/// Runs the levels of `source` from `mesh` (with its `creases`) until a
+/// stop rule or the source ends them: at most `max_level`, and stopping
+/// when a level lowers the error measure by less than `min_gain`. `mesh` and
+/// `creases` end as the last level's; returns whether the run converged
+/// and why it stopped.
+pub(crate) fn run_levels(
+    source: &mut dyn LevelFit,
+    mesh: &mut PolyMesh,
+    creases: &mut Vec<Crease>,
+    max_level: usize,
+    min_gain: Real,
+) -> Result<(bool, String)> {
+    loop {
+        let level = source.level();
+        check_level_memory(level, mesh.num_faces())?;
+        let refiner = Refiner::new(mesh, &crease_options(creases))?;
+        match source.fit_level(level, &refiner, mesh, creases)? {
+            Verdict::Again => continue,
+            Verdict::Stop(converged, reason) => return Ok((converged, reason)),
+            Verdict::Judge { met, gain, measure } => {
+                if let Some(stop) =
+                    stop_after_level(level, met, max_level, gain, min_gain, &measure)
+                {
+                    return Ok(stop);
+                }
+            }
+        }
+        let how = source.refinement(level, mesh)?;
+        if let Refine::Stop(converged, reason) = how {
+            return Ok((converged, reason));
+        }
+        let h = refiner.refine_uniform(1)?;
+        let (next, next_creases) = match how {
+            Refine::Adaptive { rank, cap } => {
+                let split = split_within(mesh, &h, creases, &rank, cap)?;
+                let n = split.local.mesh.num_vertices();
+                if let Some(stop) =
+                    source.refined(level, mesh, creases, Refined::Adaptive(&split), n)?
+                {
+                    return Ok(stop);
+                }
+                (split.local.mesh, split.creases)
+            }
+            _ => {
+                let p1 = h.stencil(0).apply(&mesh.positions)?;
+                let next = h.mesh(1, p1);
+                let next_creases = refined_creases(&h, &next, None, creases);
+                let n = next.num_vertices();
+                if let Some(stop) = source.refined(level, mesh, creases, Refined::Uniform, n)? {
+                    return Ok(stop);
+                }
+                (next, next_creases)
+            }
+        };
+        *mesh = next;
+        *creases = next_creases;
+    }
+}
 
 /// Whether a run stops after `level`, and why: `met` is the reason when
 /// the level meets the driver's tolerance (the run has converged); else the

@@ -3,6 +3,7 @@
 //! tension keeps it fair, and when the model settles above the tolerance it
 //! is subdivided and the fit continues at the finer level.
 
+mod cloud_levels;
 mod creases;
 mod driver;
 pub mod fairness;
@@ -16,6 +17,7 @@ mod report;
 mod sampling;
 mod start;
 mod system;
+mod untangle;
 
 pub use creases::Crease;
 pub use driver::{FitResult, crease_options, fit_point_cloud, fit_screened_cloud};
