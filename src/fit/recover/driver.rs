@@ -15,25 +15,26 @@
 
 use std::time::Instant;
 
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
+use super::two_sided::{Candidates, far_points};
 use super::{PreparedVolume, RecoverLevel, RecoverParams, RecoverReport};
 use crate::dynamics::{
     MaterialParams, PcgParams, SampleRows, gauss_legendre, patch_sample_rows, square_rule,
 };
 use crate::error::{Error, Result};
+use crate::fit::Crease;
 use crate::fit::ErrorStats;
 use crate::fit::Refinement;
-use crate::fit::levels::{fitted_worse, split_within, stop_after_level};
-use crate::fit::system::{LevelSystem, check_level_memory};
+use crate::fit::levels::{LevelFit, Refine, Refined, Verdict, fitted_worse, run_levels};
+use crate::fit::system::LevelSystem;
 use crate::forces::{
     ImageField, Offset, RowSprings, SpringSystem, inflation_force, spread_point_springs,
 };
-use crate::limit::{ClosestPoint, ClosestPointEngine, ClosestPointParams, PatchTable};
+use crate::limit::{ClosestPointEngine, ClosestPointParams, PatchTable};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::PolyMesh;
-use crate::subdivision::{RefineOptions, Refiner};
+use crate::subdivision::Refiner;
 use crate::topology::face_of_corner;
 
 /// A recovered shape and what it took.
@@ -67,28 +68,106 @@ pub fn recover_shape(
     crate::mesh::check_finite(points)?;
     crate::mesh::check_finite(boundary)?;
     let start = Instant::now();
-    let field = ImageField {
-        smoothed: &prepared.smoothed,
-        potential: prepared.potential.as_ref(),
-        model: params.boundary,
-        inside_level: prepared.inside_level,
-        bright_inside: params.bright_inside,
-        contrast: {
-            let (lo, hi) = prepared.smoothed.range();
-            (hi - lo) as Real
+    let mut fit = VolumeFit {
+        field: ImageField {
+            smoothed: &prepared.smoothed,
+            potential: prepared.potential.as_ref(),
+            model: params.boundary,
+            inside_level: prepared.inside_level,
+            bright_inside: params.bright_inside,
+            contrast: {
+                let (lo, hi) = prepared.smoothed.range();
+                (hi - lo) as Real
+            },
         },
+        voxel: prepared.smoothed.voxel_size(),
+        points,
+        boundary,
+        params,
+        progress,
+        levels: Vec::new(),
+        coarser: None,
+        dropped: false,
+        off: Vec::new(),
+        budget: 0.0,
+        cap: 0.0,
     };
-    let voxel = prepared.smoothed.voxel_size();
     let mut mesh = init.clone();
-    let mut levels: Vec<RecoverLevel> = Vec::new();
-    // The previous level's result, returned if the next one is worse.
-    let mut coarser: Option<PolyMesh> = None;
-    let mut dropped = false;
-    let (converged, stop_reason) = loop {
-        let level = levels.len();
+    let (converged, stop_reason) = run_levels(
+        &mut fit,
+        &mut mesh,
+        &mut Vec::new(),
+        params.max_level,
+        params.min_level_gain,
+    )?;
+    let returned_level = fit
+        .levels
+        .len()
+        .saturating_sub(1 + usize::from(fit.dropped));
+    Ok(RecoverResult {
+        control: mesh,
+        report: RecoverReport {
+            returned_level,
+            voxel: fit.voxel,
+            sigma: prepared.sigma,
+            inside_level: prepared.inside_level,
+            smoothing_seconds: prepared.smoothing_seconds,
+            potential_seconds: prepared.potential_seconds,
+            levels: fit.levels,
+            converged,
+            stop_reason,
+            seconds: start.elapsed().as_secs_f64()
+                + prepared.smoothing_seconds
+                + prepared.potential_seconds,
+        },
+    })
+}
+
+/// The recovery of one volume, level after level ([`LevelFit`]): image
+/// springs along the normals, the two-sided forces and the user's points.
+struct VolumeFit<'a> {
+    field: ImageField<'a>,
+    voxel: Real,
+    points: &'a [Point3],
+    boundary: &'a [Point3],
+    params: &'a RecoverParams,
+    progress: &'a mut dyn FnMut(usize, usize, Real),
+    levels: Vec<RecoverLevel>,
+    /// The previous level's result, returned if the next one is worse.
+    coarser: Option<PolyMesh>,
+    /// Whether the last level was dropped for it.
+    dropped: bool,
+    /// How far off the boundary each face of the last level is (counts).
+    off: Vec<usize>,
+    /// The adaptive refinement's control-point budget and cap.
+    budget: Real,
+    cap: Real,
+}
+
+impl LevelFit for VolumeFit<'_> {
+    fn level(&self) -> usize {
+        self.levels.len()
+    }
+
+    fn fit_level(
+        &mut self,
+        level: usize,
+        refiner: &Refiner,
+        mesh: &mut PolyMesh,
+        _creases: &mut Vec<Crease>,
+    ) -> Result<Verdict> {
         let level_start = Instant::now();
-        check_level_memory(level, mesh.num_faces())?;
-        let refiner = Refiner::new(&mesh, &RefineOptions::default())?;
+        let voxel = self.voxel;
+        let VolumeFit {
+            ref field,
+            points,
+            boundary,
+            params,
+            ref mut progress,
+            ref mut levels,
+            ref coarser,
+            ..
+        } = *self;
         if (0..refiner.level.num_edges()).any(|e| refiner.level.is_boundary_edge(e)) {
             return Err(Error::Topology(
                 "the initial mesh has a boundary: recovering a volume needs a closed surface"
@@ -355,29 +434,29 @@ pub fn recover_shape(
                 100.0 * last.unresolved,
                 level - 1
             );
-            mesh = parent.clone();
-            dropped = true;
-            break (false, reason);
+            *mesh = parent.clone();
+            self.dropped = true;
+            return Ok(Verdict::Stop(false, reason));
         }
         if outside_box > 0.0 {
-            break (
+            return Ok(Verdict::Stop(
                 false,
                 format!(
                     "the surface left the volume's box at level {level}: {:.0} of its {} samples lie more than 1 voxel outside",
                     outside_box * weights.len() as Real,
                     weights.len()
                 ),
-            );
+            ));
         }
         if unresolved > params.max_unresolved {
-            break (
+            return Ok(Verdict::Stop(
                 false,
                 format!(
                     "{:.1} % of the surface found no boundary within ±{search:.1} voxels at level {level} (more than {:.0} %): finer levels would not find it",
                     100.0 * unresolved,
                     100.0 * params.max_unresolved
                 ),
-            );
+            ));
         }
         let met = (offsets.p95 <= params.tolerance_voxels
             && unresolved < 0.01
@@ -390,19 +469,19 @@ pub fn recover_shape(
             }
             _ => None,
         };
-        if let Some(stop) = stop_after_level(
-            level,
+        self.off = off;
+        Ok(Verdict::Judge {
             met,
-            params.max_level,
             gain,
-            params.min_level_gain,
-            "RMS offset",
-        ) {
-            break stop;
-        }
-        let edge = median_edge_length(&mesh, &mesh.positions);
+            measure: "RMS offset".into(),
+        })
+    }
+
+    fn refinement(&mut self, level: usize, mesh: &PolyMesh) -> Result<Refine> {
+        let (params, voxel, boundary) = (self.params, self.voxel, self.boundary);
+        let edge = median_edge_length(mesh, &mesh.positions);
         if 0.5 * edge < params.min_edge_voxels * voxel {
-            break (
+            return Ok(Refine::Stop(
                 false,
                 format!(
                     "level {} would have control edges of {:.2} voxels, below the {} voxel minimum",
@@ -410,67 +489,59 @@ pub fn recover_shape(
                     0.5 * edge / voxel,
                     params.min_edge_voxels
                 ),
-            );
+            ));
         }
-        let h = refiner.refine_uniform(1)?;
-        let next = match params.refinement {
-            Refinement::Uniform => {
-                let p1 = h.stencil(0).apply(&mesh.positions)?;
-                h.mesh(1, p1)
-            }
-            Refinement::Adaptive => {
-                // The worst first, within the growth allowed.
-                let mut rank: Vec<usize> = (0..off.len()).filter(|&f| off[f] > 0).collect();
-                rank.sort_by(|&a, &b| off[b].cmp(&off[a]).then(a.cmp(&b)));
-                if rank.is_empty() {
-                    break (
-                        false,
-                        format!(
-                            "no face of level {level} is off the boundary: finer levels would not follow it better"
-                        ),
-                    );
-                }
-                let budget = params.max_control_share * boundary.len() as Real;
-                let cap = if boundary.is_empty() {
-                    params.max_level_growth * mesh.num_vertices() as Real
-                } else {
-                    budget.min(params.max_level_growth * mesh.num_vertices() as Real)
-                };
-                let next = split_within(&mesh, &h, &[], &rank, cap)?.local.mesh;
-                if next.num_vertices() as Real > cap {
-                    break (
-                        false,
-                        format!(
-                            "splitting any face of level {level} ({} control points) would pass the budget of {budget:.0} ({:.0} % of the {} iso-surface points)",
-                            mesh.num_vertices(),
-                            100.0 * params.max_control_share,
-                            boundary.len()
-                        ),
-                    );
-                }
-                next
-            }
+        if params.refinement == Refinement::Uniform {
+            return Ok(Refine::Uniform);
+        }
+        // The worst first, within the growth allowed.
+        let off = &self.off;
+        let mut rank: Vec<usize> = (0..off.len()).filter(|&f| off[f] > 0).collect();
+        rank.sort_by(|&a, &b| off[b].cmp(&off[a]).then(a.cmp(&b)));
+        if rank.is_empty() {
+            return Ok(Refine::Stop(
+                false,
+                format!(
+                    "no face of level {level} is off the boundary: finer levels would not follow it better"
+                ),
+            ));
+        }
+        self.budget = params.max_control_share * boundary.len() as Real;
+        let growth = params.max_level_growth * mesh.num_vertices() as Real;
+        self.cap = if boundary.is_empty() {
+            growth
+        } else {
+            self.budget.min(growth)
         };
-        coarser = Some(std::mem::replace(&mut mesh, next));
-    };
-    let returned_level = levels.len().saturating_sub(1 + usize::from(dropped));
-    Ok(RecoverResult {
-        control: mesh,
-        report: RecoverReport {
-            returned_level,
-            voxel,
-            sigma: prepared.sigma,
-            inside_level: prepared.inside_level,
-            smoothing_seconds: prepared.smoothing_seconds,
-            potential_seconds: prepared.potential_seconds,
-            levels,
-            converged,
-            stop_reason,
-            seconds: start.elapsed().as_secs_f64()
-                + prepared.smoothing_seconds
-                + prepared.potential_seconds,
-        },
-    })
+        Ok(Refine::Adaptive {
+            rank,
+            cap: self.cap,
+        })
+    }
+
+    fn refined(
+        &mut self,
+        level: usize,
+        mesh: &PolyMesh,
+        _creases: &[Crease],
+        next: Refined,
+        next_vertices: usize,
+    ) -> Result<Option<(bool, String)>> {
+        if matches!(next, Refined::Adaptive(_)) && next_vertices as Real > self.cap {
+            return Ok(Some((
+                false,
+                format!(
+                    "splitting any face of level {level} ({} control points) would pass the budget of {:.0} ({:.0} % of the {} iso-surface points)",
+                    mesh.num_vertices(),
+                    self.budget,
+                    100.0 * self.params.max_control_share,
+                    self.boundary.len()
+                ),
+            )));
+        }
+        self.coarser = Some(mesh.clone());
+        Ok(None)
+    }
 }
 
 /// How far `x` lies outside `volume`'s sample box (`0 ≤ index ≤ n − 1`),
@@ -508,87 +579,4 @@ fn gauss_points(table: &PatchTable, order: usize) -> Vec<(usize, [Real; 2])> {
     (0..table.num_patches())
         .flat_map(|f| rule.iter().map(move |&(st, _)| (f, st)))
         .collect()
-}
-
-/// The two-sided forces' candidates: iso-surface points, and each one's
-/// nearest sample carried from one step to the next of a level (the same
-/// samples, moved; `u32::MAX` before the first search).
-struct Candidates {
-    points: Vec<Point3>,
-    nearest: Vec<u32>,
-}
-
-impl Candidates {
-    fn new(points: Vec<Point3>) -> Candidates {
-        let nearest = vec![u32::MAX; points.len()];
-        Candidates { points, nearest }
-    }
-}
-
-/// The points of `from` outside the limit surface of `engine` (whose
-/// samples `xs`, with tangents `us`, `vs`, sit at `at`) and farther than
-/// `reach` from it, with their closest points: the two-sided forces'
-/// springs. A point within `reach` of a sample, or behind its nearest
-/// sample's tangent plane, is left out at once; the others are searched
-/// from their nearest sample's patch. Points inside are left out: there the surface bridges a
-/// groove that the image springs along its normals see (a sulcus, a gap
-/// between legs), and a coarse level cannot follow a deep one; outside, it
-/// has missed a part (a horn tip, a leg the cage lost).
-///
-/// A point still within `reach` of its last nearest sample has its nearest
-/// sample within reach too, so is left out without a search. The result is
-/// the same as searching every point; most points stay near the surface
-/// between steps, so most searches are saved.
-fn far_points(
-    engine: &ClosestPointEngine,
-    xs: &[Point3],
-    us: &[Point3],
-    vs: &[Point3],
-    at: &[(usize, [Real; 2])],
-    from: &mut Candidates,
-    reach: Real,
-) -> Result<(Vec<Point3>, Vec<ClosestPoint>)> {
-    if from.points.is_empty() || xs.is_empty() {
-        return Ok((Vec::new(), Vec::new()));
-    }
-    let reach2 = reach * reach;
-    let near = |b: &Point3, i: u32| {
-        xs.get(i as usize)
-            .is_some_and(|x| (b - x).norm_squared() <= reach2)
-    };
-    if from
-        .points
-        .par_iter()
-        .zip(from.nearest.par_iter())
-        .all(|(b, &i)| near(b, i))
-    {
-        return Ok((Vec::new(), Vec::new()));
-    }
-    let tree = ImmutableKdTree::<Real, 3>::new_from_slice(
-        &xs.iter().map(|x| [x.x, x.y, x.z]).collect::<Vec<_>>(),
-    );
-    let (candidates, starts): (Vec<Point3>, Vec<(u32, [Real; 2])>) = from
-        .points
-        .par_iter()
-        .zip(from.nearest.par_iter_mut())
-        .filter_map(|(b, cached)| {
-            if near(b, *cached) {
-                return None;
-            }
-            let nn = tree.nearest_one::<SquaredEuclidean>(&[b.x, b.y, b.z]);
-            *cached = nn.item as u32;
-            let i = nn.item as usize;
-            let outward = (b - xs[i]).dot(&us[i].coords.cross(&vs[i].coords)) > 0.0;
-            (nn.distance > reach2 && outward).then(|| {
-                let (f, st) = at[i];
-                (*b, (f as u32, st))
-            })
-        })
-        .unzip();
-    let closest = engine.closest_points_near(&candidates, &starts)?;
-    Ok(candidates
-        .into_iter()
-        .zip(closest)
-        .filter(|(b, c)| c.distance > reach && (b - c.point).dot(&c.normal) > 0.0)
-        .unzip())
 }

@@ -11,6 +11,7 @@ mod prepare;
 mod quality;
 mod report;
 mod start;
+mod two_sided;
 mod voxel_components;
 
 pub use driver::{RecoverResult, recover_shape};
