@@ -22,7 +22,7 @@ use crate::topology::SHARPNESS_INFINITE;
 use super::crease_options;
 use super::creases::{Crease, CreaseData, detect_creases, refined_creases};
 use super::init::outliers::{Screening, screen};
-use super::levels::{LevelFit, Refine, Refined, Verdict, fitted_worse};
+use super::levels::{Level, LevelFit, Next, Refine, Refined, Verdict, fitted_worse};
 use super::refine_marks::{face_residuals, faces_above_noise, faces_off_data};
 use super::sampling::shuffled_order;
 use super::{FitParams, LevelReport, Refinement, ToleranceStat};
@@ -198,17 +198,13 @@ impl<'a> CloudFit<'a> {
 }
 
 impl LevelFit for CloudFit<'_> {
-    fn level(&self) -> usize {
-        self.levels.len()
-    }
-
-    fn fit_level(
-        &mut self,
-        level: usize,
-        refiner: &Refiner,
-        mesh: &mut PolyMesh,
-        creases: &mut Vec<Crease>,
-    ) -> Result<Verdict> {
+    fn fit_level(&mut self, at: Level) -> Result<Verdict> {
+        let Level {
+            number: level,
+            refiner,
+            mesh,
+            creases,
+        } = at;
         let Settled {
             report,
             engine,
@@ -457,20 +453,21 @@ impl LevelFit for CloudFit<'_> {
         })
     }
 
-    fn refined(
-        &mut self,
-        level: usize,
-        mesh: &PolyMesh,
-        creases: &[Crease],
-        next: Refined,
-        next_vertices: usize,
-    ) -> Result<Option<(bool, String)>> {
+    fn refined(&mut self, next: Next) -> Result<Option<(bool, String)>> {
+        let Next {
+            level,
+            parent: mesh,
+            creases,
+            how,
+            mesh: next,
+        } = next;
+        let next_vertices = next.num_vertices();
         let last_hints = &self
             .residuals
             .as_ref()
             .expect("a level was fitted")
             .last_hints;
-        match next {
+        match how {
             Refined::Uniform => {
                 self.refinement = "uniform".into();
                 // Patch `f` is the refined mesh's base face `f` (one uniform
@@ -508,7 +505,7 @@ impl LevelFit for CloudFit<'_> {
                         .map(|&(p, st)| match local.corner_image[p as usize] {
                             CornerImage::Face(g) => Carried::Face(g, st),
                             CornerImage::Corner(g, i) | CornerImage::Changed(g, i) => {
-                                Carried::Patch(local.mesh.face_offsets[g as usize] + i, st)
+                                Carried::Patch(next.face_offsets[g as usize] + i, st)
                             }
                         })
                         .collect(),

@@ -54,40 +54,45 @@ pub(crate) enum Refine {
 pub(crate) enum Refined<'a> {
     /// One uniform refinement of the level.
     Uniform,
-    /// The split faces.
+    /// The split faces (the split's mesh and creases moved to the next
+    /// level: [`Next::mesh`]).
     Adaptive(&'a Split),
+}
+
+/// The level a source fits ([`LevelFit::fit_level`]): its number, its
+/// control mesh and creases (which the source may replace, see
+/// [`Verdict::Again`]) and their refiner.
+pub(crate) struct Level<'a> {
+    pub number: usize,
+    pub refiner: &'a Refiner,
+    pub mesh: &'a mut PolyMesh,
+    pub creases: &'a mut Vec<Crease>,
+}
+
+/// The refinement [`run_levels`] made of the level just fitted, shown to
+/// the source before it is fitted ([`LevelFit::refined`]).
+pub(crate) struct Next<'a> {
+    /// The fitted level's number, control mesh and creases.
+    pub level: usize,
+    pub parent: &'a PolyMesh,
+    pub creases: &'a [Crease],
+    /// How it was refined, and the refined control mesh.
+    pub how: Refined<'a>,
+    pub mesh: &'a PolyMesh,
 }
 
 /// A force source of the multilevel loop.
 pub(crate) trait LevelFit {
-    /// The number of the next level to fit (the levels kept so far).
-    fn level(&self) -> usize;
-
-    /// Sets up the level of `mesh` (refined by `refiner`, with `creases`),
-    /// settles it and measures it: `mesh` ends with the fitted positions (or
-    /// whatever mesh the verdict stands for).
-    fn fit_level(
-        &mut self,
-        level: usize,
-        refiner: &Refiner,
-        mesh: &mut PolyMesh,
-        creases: &mut Vec<Crease>,
-    ) -> Result<Verdict>;
+    /// Sets up the level, settles it and measures it: its mesh ends with
+    /// the fitted positions (or whatever mesh the verdict stands for).
+    fn fit_level(&mut self, level: Level) -> Result<Verdict>;
 
     /// How the level just fitted is refined, once the stop rules go on.
     fn refinement(&mut self, level: usize, mesh: &PolyMesh) -> Result<Refine>;
 
-    /// `next` (with `next_vertices` control points) refines `mesh` (with
-    /// `creases`), the level just fitted: `Some` stops before fitting it
-    /// (a budget passed).
-    fn refined(
-        &mut self,
-        level: usize,
-        mesh: &PolyMesh,
-        creases: &[Crease],
-        next: Refined,
-        next_vertices: usize,
-    ) -> Result<Option<(bool, String)>>;
+    /// The next level is made: `Some` stops before fitting it (a budget
+    /// passed).
+    fn refined(&mut self, next: Next) -> Result<Option<(bool, String)>>;
 }
 
 /// Runs the levels of `source` from `mesh` (with its `creases`) until a
@@ -102,11 +107,17 @@ pub(crate) fn run_levels(
     max_level: usize,
     min_gain: Real,
 ) -> Result<(bool, String)> {
+    let mut level = 0;
     loop {
-        let level = source.level();
         check_level_memory(level, mesh.num_faces())?;
         let refiner = Refiner::new(mesh, &crease_options(creases))?;
-        match source.fit_level(level, &refiner, mesh, creases)? {
+        let fitting = Level {
+            number: level,
+            refiner: &refiner,
+            mesh,
+            creases,
+        };
+        match source.fit_level(fitting)? {
             Verdict::Again => continue,
             Verdict::Stop(converged, reason) => return Ok((converged, reason)),
             Verdict::Judge { met, gain, measure } => {
@@ -122,30 +133,32 @@ pub(crate) fn run_levels(
             return Ok((converged, reason));
         }
         let h = refiner.refine_uniform(1)?;
-        let (next, next_creases) = match how {
+        let (next, next_creases, split) = match how {
             Refine::Adaptive { rank, cap } => {
-                let split = split_within(mesh, &h, creases, &rank, cap)?;
-                let n = split.local.mesh.num_vertices();
-                if let Some(stop) =
-                    source.refined(level, mesh, creases, Refined::Adaptive(&split), n)?
-                {
-                    return Ok(stop);
-                }
-                (split.local.mesh, split.creases)
+                let mut split = split_within(mesh, &h, creases, &rank, cap)?;
+                let next = std::mem::take(&mut split.local.mesh);
+                let next_creases = std::mem::take(&mut split.creases);
+                (next, next_creases, Some(split))
             }
             _ => {
-                let p1 = h.stencil(0).apply(&mesh.positions)?;
-                let next = h.mesh(1, p1);
+                let next = h.mesh(1, h.stencil(0).apply(&mesh.positions)?);
                 let next_creases = refined_creases(&h, &next, None, creases);
-                let n = next.num_vertices();
-                if let Some(stop) = source.refined(level, mesh, creases, Refined::Uniform, n)? {
-                    return Ok(stop);
-                }
-                (next, next_creases)
+                (next, next_creases, None)
             }
         };
+        let how = split.as_ref().map_or(Refined::Uniform, Refined::Adaptive);
+        if let Some(stop) = source.refined(Next {
+            level,
+            parent: mesh,
+            creases,
+            how,
+            mesh: &next,
+        })? {
+            return Ok(stop);
+        }
         *mesh = next;
         *creases = next_creases;
+        level += 1;
     }
 }
 

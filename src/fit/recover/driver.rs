@@ -23,10 +23,11 @@ use crate::dynamics::{
     MaterialParams, PcgParams, SampleRows, gauss_legendre, patch_sample_rows, square_rule,
 };
 use crate::error::{Error, Result};
-use crate::fit::Crease;
 use crate::fit::ErrorStats;
 use crate::fit::Refinement;
-use crate::fit::levels::{LevelFit, Refine, Refined, Verdict, fitted_worse, run_levels};
+use crate::fit::levels::{
+    Level, LevelFit, Next, Refine, Refined, Verdict, fitted_worse, run_levels,
+};
 use crate::fit::system::LevelSystem;
 use crate::forces::{
     ImageField, Offset, RowSprings, SpringSystem, inflation_force, spread_point_springs,
@@ -34,7 +35,6 @@ use crate::forces::{
 use crate::limit::{ClosestPointEngine, ClosestPointParams, PatchTable};
 use crate::math::{Point3, Real, bbox_diagonal};
 use crate::mesh::PolyMesh;
-use crate::subdivision::Refiner;
 use crate::topology::face_of_corner;
 
 /// A recovered shape and what it took.
@@ -145,17 +145,13 @@ struct VolumeFit<'a> {
 }
 
 impl LevelFit for VolumeFit<'_> {
-    fn level(&self) -> usize {
-        self.levels.len()
-    }
-
-    fn fit_level(
-        &mut self,
-        level: usize,
-        refiner: &Refiner,
-        mesh: &mut PolyMesh,
-        _creases: &mut Vec<Crease>,
-    ) -> Result<Verdict> {
+    fn fit_level(&mut self, at: Level) -> Result<Verdict> {
+        let Level {
+            number: level,
+            refiner,
+            mesh,
+            creases: _,
+        } = at;
         let level_start = Instant::now();
         let voxel = self.voxel;
         let VolumeFit {
@@ -519,15 +515,16 @@ impl LevelFit for VolumeFit<'_> {
         })
     }
 
-    fn refined(
-        &mut self,
-        level: usize,
-        mesh: &PolyMesh,
-        _creases: &[Crease],
-        next: Refined,
-        next_vertices: usize,
-    ) -> Result<Option<(bool, String)>> {
-        if matches!(next, Refined::Adaptive(_)) && next_vertices as Real > self.cap {
+    fn refined(&mut self, next: Next) -> Result<Option<(bool, String)>> {
+        let Next {
+            level,
+            parent: mesh,
+            creases: _,
+            how,
+            mesh: next,
+        } = next;
+        let next_vertices = next.num_vertices();
+        if matches!(how, Refined::Adaptive(_)) && next_vertices as Real > self.cap {
             return Ok(Some((
                 false,
                 format!(
