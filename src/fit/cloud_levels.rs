@@ -265,7 +265,7 @@ impl LevelFit for CloudFit<'_> {
             return Ok(Verdict::Again);
         }
         levels.push(report);
-        final_dist.clone_from(&dist);
+        final_dist.clone_from(dist);
         if let Some(without) = crease_pass.take() {
             // The level fitted again with creases: keep the better fit, as
             // one level, counting both fits' work.
@@ -302,7 +302,7 @@ impl LevelFit for CloudFit<'_> {
                 *final_dist = without.dist;
                 smooth
             } else {
-                final_hints.clone_from(&last_hints);
+                final_hints.clone_from(last_hints);
                 with
             };
             levels.push(LevelReport {
@@ -315,17 +315,17 @@ impl LevelFit for CloudFit<'_> {
                 ..kept
             });
         } else {
-            final_hints.clone_from(&last_hints);
+            final_hints.clone_from(last_hints);
             if level == 0 && params.crease_angle > 0.0 {
                 let miss: Vec<Real> = data_index.iter().map(|&i| final_dist[i]).collect();
                 let found = detect_creases(
-                    &refiner,
+                    refiner,
                     &engine,
                     &mesh.positions,
                     &CreaseData {
-                        points: &data,
+                        points: data,
                         miss: &miss,
-                        tree: &data_tree,
+                        tree: data_tree,
                         noise: data_noise,
                     },
                     params.crease_angle,
@@ -405,8 +405,8 @@ impl LevelFit for CloudFit<'_> {
             .collect();
         let (mut marks, _) = faces_above_noise(
             mesh.num_faces(),
-            &face,
-            &dist,
+            face,
+            dist,
             &counted,
             data_noise,
             params.refine_significance,
@@ -438,7 +438,7 @@ impl LevelFit for CloudFit<'_> {
             ));
         }
         // The worst first: webs, then by mean squared residual.
-        let residual = face_residuals(mesh.num_faces(), &face, &dist, &counted);
+        let residual = face_residuals(mesh.num_faces(), face, dist, &counted);
         let mut rank: Vec<usize> = (0..marks.len()).filter(|&f| marks[f]).collect();
         rank.sort_by(|&a, &b| {
             off_data[b]

@@ -59,7 +59,7 @@ impl CloudFit<'_> {
             ..
         } = *self;
         let mut engine = ClosestPointEngine::with_quadtrees(
-            &refiner,
+            refiner,
             &mesh.positions,
             &ClosestPointParams {
                 level: params.patch_level,
@@ -85,7 +85,7 @@ impl CloudFit<'_> {
         )?;
         // The fairness of the control net (`FitParams::fairness`): one
         // umbrella weight per control point, raised where untangling marks.
-        let ring = vertex_rings(&mesh);
+        let ring = vertex_rings(mesh);
         let mut umbrella = vec![params.fairness / mesh.num_vertices() as Real; mesh.num_vertices()];
         system.set_fairness(&umbrella_matrix(&ring, &umbrella))?;
         let centres = system
@@ -232,7 +232,7 @@ impl CloudFit<'_> {
                 break fitted;
             }
             let crossing = SelfIntersections::with_quadtrees(
-                &refiner,
+                refiner,
                 &p,
                 UNTANGLE_CHECK_RATE,
                 quadtrees.clone(),
@@ -243,7 +243,7 @@ impl CloudFit<'_> {
             }
             untangle_round += 1;
             p = untangled(
-                &mesh,
+                mesh,
                 &ring,
                 p,
                 &crossing,

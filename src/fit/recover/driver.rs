@@ -173,7 +173,7 @@ impl LevelFit for VolumeFit<'_> {
         // Level-1 patches carry everything: the closest points of the user
         // points, the thin plate and damping, and the image springs.
         let mut engine = ClosestPointEngine::new(
-            &refiner,
+            refiner,
             &mesh.positions,
             &ClosestPointParams {
                 level: 1,
@@ -213,7 +213,7 @@ impl LevelFit for VolumeFit<'_> {
         let search_of = |p: &[Point3]| {
             params
                 .search_voxels
-                .unwrap_or((median_edge_length(&mesh, p) / voxel / 3.0).clamp(2.0, 12.0))
+                .unwrap_or((median_edge_length(mesh, p) / voxel / 3.0).clamp(2.0, 12.0))
         };
         let max_steps = if level == 0 {
             4 * params.max_steps
@@ -236,7 +236,7 @@ impl LevelFit for VolumeFit<'_> {
         // User points pull a patch as wide as a level-0 control edge at
         // every level (each subdivision halves the edges).
         let point_radius =
-            (1u64 << level.min(30)) as Real * median_edge_length(&mesh, &mesh.positions);
+            (1u64 << level.min(30)) as Real * median_edge_length(mesh, &mesh.positions);
         let mut p = mesh.positions.clone();
         let mut p_before = p.clone();
         let mut energy: Vec<Real> = Vec::new();
