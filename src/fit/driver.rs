@@ -23,6 +23,11 @@
 //! differences, unconditionally stable like the first-order step. The model
 //! then carries momentum, so the potential energy may rise for a step while
 //! it overshoots; the stop rules ([`super::levels`]) are the same.
+//!
+//! The loop itself is [`super::levels::run_levels`], shared with the volume
+//! recovery; the fit is its force source `CloudFit`
+//! (`super::cloud_levels`), and the untangling after the last level is
+//! `super::untangle`.
 
 use crate::error::Result;
 use crate::math::Real;

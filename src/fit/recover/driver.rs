@@ -6,7 +6,8 @@
 //! intensity that separates inside from outside (the iso-value, or Otsu's
 //! threshold). [`recover_shape`] then evolves the control points with the
 //! first-order dynamics of the point-cloud fit (the same [`LevelSystem`]
-//! and step, and the same stop rules, [`crate::fit::levels`]), the spring
+//! and step, and the same multilevel loop, [`crate::fit::levels::run_levels`],
+//! of which [`VolumeFit`] is a force source), the spring
 //! targets `y = x + t n` being the image boundary found along the normal of
 //! every quadrature point (see [`crate::forces::ImageField`]), with stiffness
 //! `k` proportional to the point's area. A level ends when the energy
