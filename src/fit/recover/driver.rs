@@ -90,7 +90,6 @@ pub fn recover_shape(
         coarser: None,
         dropped: false,
         off: Vec::new(),
-        budget: 0.0,
         cap: 0.0,
     };
     let mut mesh = init.clone();
@@ -140,9 +139,16 @@ struct VolumeFit<'a> {
     dropped: bool,
     /// How far off the boundary each face of the last level is (counts).
     off: Vec<usize>,
-    /// The adaptive refinement's control-point budget and cap.
-    budget: Real,
+    /// The adaptive refinement's cap on the next level's control points.
     cap: Real,
+}
+
+impl VolumeFit<'_> {
+    /// The control-point budget of adaptive levels
+    /// (`RecoverParams::max_control_share` of the iso-surface points).
+    fn budget(&self) -> Real {
+        self.params.max_control_share * self.boundary.len() as Real
+    }
 }
 
 impl LevelFit for VolumeFit<'_> {
@@ -503,12 +509,12 @@ impl LevelFit for VolumeFit<'_> {
                 ),
             ));
         }
-        self.budget = params.max_control_share * boundary.len() as Real;
+        let budget = self.budget();
         let growth = params.max_level_growth * mesh.num_vertices() as Real;
         self.cap = if boundary.is_empty() {
             growth
         } else {
-            self.budget.min(growth)
+            budget.min(growth)
         };
         Ok(Refine::Adaptive {
             rank,
@@ -531,7 +537,7 @@ impl LevelFit for VolumeFit<'_> {
                 format!(
                     "splitting any face of level {level} ({} control points) would pass the budget of {:.0} ({:.0} % of the {} iso-surface points)",
                     mesh.num_vertices(),
-                    self.budget,
+                    self.budget(),
                     100.0 * self.params.max_control_share,
                     self.boundary.len()
                 ),
