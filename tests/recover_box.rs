@@ -463,3 +463,42 @@ fn the_mni_brain_cut_by_the_box_closes_or_opens_on_the_face() {
         assert_eq!(stray, 0, "{stray} limit points of a cap left on the face");
     }
 }
+
+/// A raw volume whose sidecar names the surface's level (`iso_value`, as
+/// data-gen writes): without `--iso` the recovery takes that level set, with
+/// a note; `--iso` overrides it. The ball's intensity falls linearly from 1
+/// at radius 7 to 0 at radius 11, so level 0.25 is the sphere of radius 10
+/// and level 0.5 that of radius 9.
+#[test]
+fn a_sidecars_iso_value_is_the_default_boundary() {
+    let dir = tempfile::tempdir().unwrap();
+    let c = Point3::new(16.0, 16.0, 16.0);
+    let vol = sdf_volume([32, 32, 32], [1.0; 3], move |p| {
+        ((p - c).norm() - 9.0) / 4.0
+    });
+    write_raw(dir.path(), "ball", &vol);
+    let side = dir.path().join("ball.json");
+    let mut header: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&side).unwrap()).unwrap();
+    header["iso_value"] = serde_json::json!(0.25);
+    std::fs::write(&side, header.to_string()).unwrap();
+    let mean_radius = |extra: &[&str], out: &str| {
+        let mut args = vec!["recover", "ball.json", "-o", out];
+        args.extend_from_slice(extra);
+        let run = common::run_subdyn(dir.path(), &args);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let shape = subdyn::io::read_mesh(dir.path().join(out)).unwrap();
+        let (_, mean) = surface_error(&shape, move |p| (p - c).norm());
+        (mean, String::from_utf8_lossy(&run.stdout).into_owned())
+    };
+    let (r, text) = mean_radius(&[], "default.obj");
+    assert!((r - 10.0).abs() < 0.2, "mean radius {r}\n{text}");
+    assert!(text.contains("iso-value 0.25 from the sidecar"), "{text}");
+    let (r, text) = mean_radius(&["--iso", "0.5"], "given.obj");
+    assert!((r - 9.0).abs() < 0.2, "mean radius {r}\n{text}");
+    assert!(!text.contains("from the sidecar"), "{text}");
+}

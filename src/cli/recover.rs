@@ -57,8 +57,9 @@ pub struct RecoverArgs {
     pub init: Option<PathBuf>,
     /// The boundary is the level set at this intensity (e.g. CT Hounsfield
     /// units, negative ones too: --iso -300; 0.5 of a probability map).
-    /// Without it (or --preset) the boundary is the strongest nearby edge of
-    /// the smoothed image.
+    /// Without it (or --preset) the boundary is the level the volume's JSON
+    /// sidecar names (`iso_value`, as data-gen writes), else the strongest
+    /// nearby edge of the smoothed image.
     #[arg(long, value_name = "T", allow_negative_numbers = true)]
     pub iso: Option<f64>,
     /// A CT iso-value in Hounsfield units (NIfTI scl_slope / scl_inter are
@@ -66,9 +67,11 @@ pub struct RecoverArgs {
     /// tissue, 0), bone = +300 HU (above soft tissue, below cortical bone).
     #[arg(long, value_enum, conflicts_with = "iso")]
     pub preset: Option<CtPreset>,
-    /// Weakest edge accepted without --iso, as a fraction of the volume's strongest.
-    #[arg(long, value_name = "F", default_value_t = 0.1)]
-    pub edge_strength: f64,
+    /// The boundary is the strongest nearby edge (not a sidecar's
+    /// `iso_value`); edges weaker than this fraction of the volume's
+    /// strongest are ignored (default 0.1).
+    #[arg(long, value_name = "F", conflicts_with_all = ["iso", "preset"])]
+    pub edge_strength: Option<f64>,
     /// The object is darker than its surroundings (ventricles in T1 MRI, air).
     #[arg(long)]
     pub dark: bool,
@@ -156,6 +159,9 @@ pub struct RecoverArgs {
     pub quiet: bool,
 }
 
+/// `--edge-strength` when the edge model is used without it.
+const DEFAULT_EDGE_STRENGTH: f64 = 0.1;
+
 /// CT presets of `--preset`: iso-values in Hounsfield units.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum CtPreset {
@@ -198,11 +204,11 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     if let Some(dir) = &args.slices_png {
         subdyn::io::check_output_dir_path(dir)?;
     }
-    let params = RecoverParams {
+    let mut params = RecoverParams {
         boundary: match args.iso.or(args.preset.map(CtPreset::hounsfield)) {
             Some(value) => BoundaryModel::Iso { value },
             None => BoundaryModel::Edge {
-                min_strength: args.edge_strength,
+                min_strength: args.edge_strength.unwrap_or(DEFAULT_EDGE_STRENGTH),
             },
         },
         sigma: args.sigma,
@@ -241,9 +247,22 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     let VolumeFile {
         volume: input,
         source,
-        notes,
-        ..
+        mut notes,
+        iso_value,
     } = read_volume(&args.input, &read_options).map_err(|e| about_file(e, &args.input))?;
+    // A sidecar that names the surface's level is taken at its word unless
+    // the command line chose the boundary.
+    if let Some(value) = iso_value
+        && args.iso.is_none()
+        && args.preset.is_none()
+        && args.edge_strength.is_none()
+    {
+        params.boundary = BoundaryModel::Iso { value };
+        params.check()?;
+        notes.push(format!(
+            "iso-value {value} from the sidecar's iso_value (--iso T for another level, --edge-strength F for the edge model)"
+        ));
+    }
     let read_s = seconds(t);
     let read_peak = peak_rss();
     // The input is smoothed in its own memory and given up; the smoothed
