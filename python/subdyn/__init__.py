@@ -177,7 +177,8 @@ def recover(volume: Any, spacing: Sequence[float] = (1.0, 1.0, 1.0),
     ``volume[i, j, k]`` is the sample at world point ``origin + (i sx, j sy,
     k sz)``. ``points`` are user-placed boundary points ((m, 3)); ``init`` a
     ``(vertices, faces)`` starting mesh. Options as the CLI's flags: ``iso``
-    (negative values too), ``preset`` ("skin" -500 HU or "bone" +300 HU, for
+    (negative values too; an array has no sidecar, so where the CLI would
+    take a sidecar's ``iso_value`` pass it here), ``preset`` ("skin" -500 HU or "bone" +300 HU, for
     CT in Hounsfield units), ``edge_strength``, ``dark``, ``sigma``, ``tol`` (voxels), ``max_level``,
     ``auto``, ``seed`` ((x, y, z)), ``seed_radius``, ``resolution``,
     ``points_weight``, ``two_sided_weight``, ``two_sided_distance``

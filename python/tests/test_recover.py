@@ -22,9 +22,12 @@ def sphere_volume(tmp_path_factory):
 
 def test_recover_equals_cli(sphere_volume):
     d, volume, meta = sphere_volume
+    # The CLI takes the sidecar's iso_value as its boundary; an array carries
+    # no sidecar, so the same level is passed to Python.
     run("subdyn", "recover", d / "v.raw", "-o", d / "cli.obj", "--report", d / "cli.json",
         "--quiet", "--max-level", 1)
-    r = subdyn.recover(volume, spacing=meta["spacing"], origin=meta["origin"], max_level=1)
+    r = subdyn.recover(volume, spacing=meta["spacing"], origin=meta["origin"], max_level=1,
+                       iso=meta["iso_value"])
     v, f = subdyn.read_mesh(d / "cli.obj")
     extent = np.linalg.norm(np.array(meta["dims"]) * np.array(meta["spacing"]))
     assert r.control_vertices.shape == v.shape

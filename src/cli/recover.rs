@@ -159,9 +159,6 @@ pub struct RecoverArgs {
     pub quiet: bool,
 }
 
-/// `--edge-strength` when the edge model is used without it.
-const DEFAULT_EDGE_STRENGTH: f64 = 0.1;
-
 /// CT presets of `--preset`: iso-values in Hounsfield units.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum CtPreset {
@@ -205,11 +202,13 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
         subdyn::io::check_output_dir_path(dir)?;
     }
     let mut params = RecoverParams {
-        boundary: match args.iso.or(args.preset.map(CtPreset::hounsfield)) {
-            Some(value) => BoundaryModel::Iso { value },
-            None => BoundaryModel::Edge {
-                min_strength: args.edge_strength.unwrap_or(DEFAULT_EDGE_STRENGTH),
-            },
+        boundary: match (
+            args.iso.or(args.preset.map(CtPreset::hounsfield)),
+            args.edge_strength,
+        ) {
+            (Some(value), _) => BoundaryModel::Iso { value },
+            (None, Some(min_strength)) => BoundaryModel::Edge { min_strength },
+            (None, None) => RecoverParams::default().boundary,
         },
         sigma: args.sigma,
         bright_inside: !args.dark,
