@@ -248,7 +248,7 @@ impl LevelFit for VolumeFit<'_> {
         let mut p_before = p.clone();
         let mut energy: Vec<Real> = Vec::new();
         let (mut steps, mut cg_iterations, mut still) = (0, 0, false);
-        let (offsets, unresolved, search, outside_box, unmatched, off) = loop {
+        let (offsets, unresolved, search, outside_box, unmatched, off, local) = loop {
             let search = search_of(&p);
             let range = search * voxel;
             let xs = j.apply(&p)?;
@@ -361,11 +361,16 @@ impl LevelFit for VolumeFit<'_> {
                 // it holds, and while the offsets' 95th percentile is above
                 // the tolerance, its samples farther from the boundary than it.
                 let mut off = vec![0usize; mesh.num_faces()];
-                let tolerance = params.tolerance_voxels * voxel;
                 let stats = ErrorStats::new(&t, bbox_diagonal(&xs) / voxel);
-                if stats.p95 > params.tolerance_voxels {
+                let local = local_misses(&t, params.tolerance_voxels);
+                let beyond = if stats.p95 > params.tolerance_voxels {
+                    Some(params.tolerance_voxels)
+                } else {
+                    local.then_some(LOCAL_MISS * params.tolerance_voxels)
+                };
+                if let Some(limit) = beyond {
                     for (f, o) in at.iter().zip(&found) {
-                        if matches!(o.2, Offset::Boundary(t) if t.abs() > tolerance) {
+                        if matches!(o.2, Offset::Boundary(t) if t.abs() > limit * voxel) {
                             off[face_of_patch[f.0] as usize] += 1;
                         }
                     }
@@ -373,7 +378,15 @@ impl LevelFit for VolumeFit<'_> {
                 for c in &far_closest {
                     off[face_of_patch[c.patch.0 as usize] as usize] += 1;
                 }
-                break (stats, unresolved, search, outside_box, unmatched, off);
+                break (
+                    stats,
+                    unresolved,
+                    search,
+                    outside_box,
+                    unmatched,
+                    off,
+                    local,
+                );
             }
             let load = if params.inflation != 0.0 {
                 Some(inflation_force(
@@ -462,6 +475,7 @@ impl LevelFit for VolumeFit<'_> {
             ));
         }
         let met = (offsets.p95 <= params.tolerance_voxels
+            && !local
             && unresolved < 0.01
             && unmatched <= params.max_unmatched)
             .then(|| format!("tolerance met at level {level}"));
@@ -556,6 +570,29 @@ fn voxels_outside_box(volume: &crate::volume::Volume, x: &Point3) -> Real {
     (0..3)
         .map(|a| (-c[a]).max(c[a] - (dims[a] - 1) as Real))
         .fold(0.0, Real::max)
+}
+
+/// Offsets beyond this many tolerances are a local miss.
+const LOCAL_MISS: Real = 1.2;
+
+/// At most this share of the samples for [`local_misses`].
+const LOCAL_MISS_SHARE: Real = 0.001;
+
+/// Whether the offsets `t` (voxels) hold a few local misses: samples off
+/// the boundary by more than [`LOCAL_MISS`] × `tolerance`, but at most
+/// [`LOCAL_MISS_SHARE`] of them. The 95th percentile cannot see them: they
+/// are a tip or an edge the level's cage is too coarse to reach (the
+/// anvil's horn, 0.007 % of its samples at 0.87 voxel, while its 95th
+/// percentile is 0.17), and splitting the few faces they lie on is cheap,
+/// so the level is refined there. Many such samples are a surface rough
+/// everywhere at this resolution (the MNI brain's sulci: 2.5 % beyond 0.6
+/// voxel at level 0), whose faces would all be split: the 95th percentile
+/// alone judges it. Chosen on the recovery bench's anvil, spot, bracket and
+/// the MNI T1 brain (`benches/compare/RESULTS.md`).
+fn local_misses(t: &[Real], tolerance: Real) -> bool {
+    let limit = LOCAL_MISS * tolerance;
+    let misses = t.iter().filter(|&&x| x > limit).count();
+    misses > 0 && misses as Real <= LOCAL_MISS_SHARE * t.len() as Real
 }
 
 /// Median length of the control mesh's edges at positions `p` (each face
