@@ -621,3 +621,25 @@ fn gauss_points(table: &PatchTable, order: usize) -> Vec<(usize, [Real; 2])> {
         .flat_map(|f| rule.iter().map(move |&(st, _)| (f, st)))
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A few samples beyond 1.2 × the tolerance (a tip) refine; none, or a
+    /// share above 0.1 % (a surface rough everywhere), do not.
+    #[test]
+    fn local_misses_are_a_few_samples_beyond_the_tolerance() {
+        let mut t = vec![0.2; 10_000];
+        assert!(!local_misses(&t, 0.5));
+        t[17] = 0.87;
+        assert!(local_misses(&t, 0.5));
+        t[18] = 0.59; // within 1.2 × 0.5
+        assert!(local_misses(&t, 0.5));
+        for x in t.iter_mut().take(11) {
+            *x = 0.8;
+        }
+        assert!(!local_misses(&t, 0.5), "12 of 10,000 is more than 0.1 %");
+        assert!(!local_misses(&[], 0.5));
+    }
+}
