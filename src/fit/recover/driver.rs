@@ -359,16 +359,18 @@ impl LevelFit for VolumeFit<'_> {
                 // How far off the boundary each face is, for adaptive
                 // refinement: the far iso-surface points whose closest point
                 // it holds, and while the offsets' 95th percentile is above
-                // the tolerance, its samples farther from the boundary than it.
+                // the tolerance, its samples farther from the boundary than it
+                // (else, with a few local misses, its samples beyond
+                // LOCAL_MISS × it).
                 let mut off = vec![0usize; mesh.num_faces()];
                 let stats = ErrorStats::new(&t, bbox_diagonal(&xs) / voxel);
                 let local = local_misses(&t, params.tolerance_voxels);
-                let beyond = if stats.p95 > params.tolerance_voxels {
+                let off_limit = if stats.p95 > params.tolerance_voxels {
                     Some(params.tolerance_voxels)
                 } else {
                     local.then_some(LOCAL_MISS * params.tolerance_voxels)
                 };
-                if let Some(limit) = beyond {
+                if let Some(limit) = off_limit {
                     for (f, o) in at.iter().zip(&found) {
                         if matches!(o.2, Offset::Boundary(t) if t.abs() > limit * voxel) {
                             off[face_of_patch[f.0] as usize] += 1;
