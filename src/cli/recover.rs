@@ -201,15 +201,17 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     if let Some(dir) = &args.slices_png {
         subdyn::io::check_output_dir_path(dir)?;
     }
+    // The boundary the command line chose, if it chose one.
+    let chosen = match (
+        args.iso.or(args.preset.map(CtPreset::hounsfield)),
+        args.edge_strength,
+    ) {
+        (Some(value), _) => Some(BoundaryModel::Iso { value }),
+        (None, Some(min_strength)) => Some(BoundaryModel::Edge { min_strength }),
+        (None, None) => None,
+    };
     let mut params = RecoverParams {
-        boundary: match (
-            args.iso.or(args.preset.map(CtPreset::hounsfield)),
-            args.edge_strength,
-        ) {
-            (Some(value), _) => BoundaryModel::Iso { value },
-            (None, Some(min_strength)) => BoundaryModel::Edge { min_strength },
-            (None, None) => RecoverParams::default().boundary,
-        },
+        boundary: chosen.unwrap_or(RecoverParams::default().boundary),
         sigma: args.sigma,
         bright_inside: !args.dark,
         tolerance_voxels: args.tol,
@@ -252,9 +254,7 @@ pub fn run(args: &RecoverArgs) -> anyhow::Result<()> {
     // A sidecar that names the surface's level is taken at its word unless
     // the command line chose the boundary.
     if let Some(value) = iso_value
-        && args.iso.is_none()
-        && args.preset.is_none()
-        && args.edge_strength.is_none()
+        && chosen.is_none()
     {
         params.boundary = BoundaryModel::Iso { value };
         params.check()?;
