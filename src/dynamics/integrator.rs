@@ -2,17 +2,10 @@
 //! Mandal, Vemuri 1998, eq. 16 and §III-C) for interactive use: a drag
 //! spring, inflation or any other load, step after step.
 //!
-//! With `p̈ ≈ (p⁺ − 2p + p⁻)/Δt²` and `ṗ ≈ (p⁺ − p)/Δt` the paper's
-//! `M p̈ + D ṗ + K p = f_p` becomes one linear system per step,
-//!
-//! `(M/Δt² + D/Δt + K + S) p⁺ = M (2p − p⁻)/Δt² + D p/Δt + f`,
-//!
-//! where `S` is the stiffness of implicit springs (`Σ k JᵀJ`, a drag
-//! spring's or data springs') and `f` the load (the springs' `Σ k Jᵀ d` plus
-//! explicit forces such as inflation). Without a mass it is the first-order
-//! (massless) dynamics `D ṗ + K p = f_p`. Both are backward Euler steps and
-//! dissipate: multiplying the step by `p⁺ − p` gives, for a fixed `S` and
-//! `f`, `E(p⁺, p) − E(p, p⁻) = −½‖v⁺ − v‖²_M − Δt‖v⁺‖²_D − ½‖p⁺ − p‖²_{K+S}`
+//! Each step is the linear system of eq. 16 ([`ImplicitSystem`]): a backward
+//! Euler step, which dissipates: multiplying it by `p⁺ − p` gives, for fixed
+//! springs `S` and load `f`,
+//! `E(p⁺, p) − E(p, p⁻) = −½‖v⁺ − v‖²_M − Δt‖v⁺‖²_D − ½‖p⁺ − p‖²_{K+S}`
 //! with `E(p, p⁻) = ½ vᵀ M v + ½ pᵀ (K + S) p − fᵀ p`, `v = (p − p⁻)/Δt`
 //! ([`SurfaceDynamics::energy`]): the energy never rises, which is what
 //! equilibrium detection by energy change relies on.
@@ -31,6 +24,7 @@ use crate::math::{Point3, Real, first_non_finite};
 use crate::stencil::StencilTable;
 
 use super::elements::patch_matrices;
+use super::implicit::ImplicitSystem;
 use super::matrices::MaterialParams;
 use super::pcg::{PcgParams, pcg};
 
@@ -62,12 +56,9 @@ pub struct StepReport {
 /// its positions now and one step before, and the solver's state.
 #[derive(Clone, Debug)]
 pub struct SurfaceDynamics {
-    mass: Option<StencilTable>,
-    damping: StencilTable,
     stiffness: StencilTable,
-    /// `M/Δt² + D/Δt + K`.
-    base: StencilTable,
-    dt: Real,
+    /// `M/Δt² + D/Δt + K`, `D/Δt` and `M/Δt²`.
+    implicit: ImplicitSystem,
     solver: LinearSolver,
     p: Vec<Point3>,
     p_before: Vec<Point3>,
@@ -107,16 +98,23 @@ impl SurfaceDynamics {
                 "dynamics: control point {i} is not finite"
             )));
         }
-        let mut base = stiffness.linear_combination(1.0, &damping, 1.0 / dt)?;
+        let scaled = |m: &StencilTable, s: Real| StencilTable {
+            weights: m.weights.iter().map(|w| s * w).collect(),
+            ..m.clone()
+        };
+        let damping = scaled(&damping, 1.0 / dt);
+        let mass = mass.map(|m| scaled(&m, 1.0 / (dt * dt)));
+        let mut base = stiffness.linear_combination(1.0, &damping, 1.0)?;
         if let Some(m) = &mass {
-            base = base.linear_combination(1.0, m, 1.0 / (dt * dt))?;
+            base = base.linear_combination(1.0, m, 1.0)?;
         }
         Ok(SurfaceDynamics {
-            mass,
-            damping,
+            implicit: ImplicitSystem {
+                base,
+                damping,
+                mass,
+            },
             stiffness,
-            base,
-            dt,
             solver,
             p_before: positions.clone(),
             p: positions,
@@ -180,12 +178,13 @@ impl SurfaceDynamics {
         if let Some(s) = springs {
             e += 0.5 * dot(&s.apply(&self.p)?, &self.p);
         }
-        if let Some(m) = &self.mass {
+        if let Some(m) = &self.implicit.mass {
+            // `M/Δt²` on `p − p⁻`: `½ vᵀ M v` with `v = (p − p⁻)/Δt`.
             let v: Vec<Point3> = self
                 .p
                 .iter()
                 .zip(&self.p_before)
-                .map(|(a, b)| Point3::from((a - b) / self.dt))
+                .map(|(a, b)| Point3::from(a - b))
                 .collect();
             e += 0.5 * dot(&m.apply(&v)?, &v);
         }
@@ -196,25 +195,9 @@ impl SurfaceDynamics {
     /// `load` (`f`, one vector per control point).
     pub fn step(&mut self, springs: Option<&StencilTable>, load: &[Point3]) -> Result<StepReport> {
         let before = self.energy(springs, load)?;
-        let a = match springs {
-            Some(s) => self.base.linear_combination(1.0, s, 1.0)?,
-            None => self.base.clone(),
-        };
-        let mut rhs = self.damping.apply(&self.p)?;
-        for (r, f) in rhs.iter_mut().zip(load) {
-            r.coords = r.coords / self.dt + f.coords;
-        }
-        if let Some(m) = &self.mass {
-            let inertia: Vec<Point3> = self
-                .p
-                .iter()
-                .zip(&self.p_before)
-                .map(|(a, b)| Point3::from((2.0 * a.coords - b.coords) / (self.dt * self.dt)))
-                .collect();
-            for (r, x) in rhs.iter_mut().zip(m.apply(&inertia)?) {
-                r.coords += x.coords;
-            }
-        }
+        let (a, rhs) = self
+            .implicit
+            .system(springs.cloned(), &[load], &self.p, &self.p_before)?;
         let (next, cg_iterations, factored) = match self.solver {
             LinearSolver::Pcg(params) => {
                 let mut x = self.p.clone();

@@ -6,6 +6,7 @@
 //! Cholesky (`linalg`'s scalar factor, re-exported here).
 
 mod elements;
+mod implicit;
 mod integrator;
 mod matrices;
 mod pcg;
@@ -17,6 +18,7 @@ pub use elements::{
     PatchElements, parameter_area, patch_damping_matrix, patch_matrices,
     patch_stiffness_and_damping, patch_stiffness_matrix, stiffness_and_damping_elements,
 };
+pub use implicit::ImplicitSystem;
 pub use integrator::{LinearSolver, StepReport, SurfaceDynamics};
 pub use matrices::{MaterialParams, damping_matrix, mass_matrix, stiffness_matrix};
 pub use pcg::{PcgParams, PcgReport, pcg};

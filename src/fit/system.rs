@@ -1,20 +1,15 @@
 //! The control-point system of one level, shared by the point-cloud fit
 //! and the volume recovery: the thin plate `K`, the damping `D` and the
 //! mass `M` assembled in the fixed pattern of a [`PatchAssembly`], and the
-//! implicit step of the dynamics (Qin, Mandal, Vemuri 1998, eq. 16) that
-//! both drivers take.
-//!
-//! With the springs `Σ k JᵀJ`, `Σ k Jᵀ d` treated implicitly, backward
-//! differences `p̈ ≈ (p⁺ − 2p + p⁻)/Δt²`, `ṗ ≈ (p⁺ − p)/Δt` give
-//!
-//! `(μ/Δt² · M + γ/Δt · D + K + Σ k JᵀJ) p⁺ = μ/Δt² · M (2p − p⁻) + γ/Δt · D p + Σ k Jᵀ d + f`,
-//!
-//! (the first-order, massless step when `M` is absent), `f` any explicit
-//! load (inflation). The time step is folded into the weights `μ/Δt²` and
-//! `γ/Δt` the callers pass.
+//! implicit step (Qin, Mandal, Vemuri 1998, eq. 16; assembled by
+//! [`ImplicitSystem`]) that both drivers take, with the data springs
+//! `Σ k JᵀJ`, `Σ k Jᵀ d` implicit and `f` any explicit load (inflation).
+//! The time step is folded into the weights `μ/Δt²` and `γ/Δt` the callers
+//! pass.
 
 use crate::dynamics::{
-    MaterialParams, PcgParams, PcgReport, patch_damping_matrix, pcg, stiffness_and_damping_elements,
+    ImplicitSystem, MaterialParams, PcgParams, PcgReport, patch_damping_matrix, pcg,
+    stiffness_and_damping_elements,
 };
 use crate::error::Result;
 use crate::forces::{PatchAssembly, SpringSystem};
@@ -52,11 +47,8 @@ pub(crate) struct LevelSystem {
     kd_base: Vec<Real>,
     /// `K` with the fairness term: the stiffness energy's matrix.
     k: StencilTable,
-    /// `K + D (+ M)` with the fairness term: the step's matrix without
-    /// the springs.
-    kd: Vec<Real>,
-    d: StencilTable,
-    m: Option<StencilTable>,
+    /// The step's matrices (`K + D (+ M)` with the fairness term, `D`, `M`).
+    implicit: ImplicitSystem,
 }
 
 impl LevelSystem {
@@ -100,12 +92,14 @@ impl LevelSystem {
         };
         Ok(LevelSystem {
             k: assembly.matrix(k.clone()),
-            kd: kd_base.clone(),
-            d: assembly.matrix(d),
+            implicit: ImplicitSystem {
+                base: assembly.matrix(kd_base.clone()),
+                damping: assembly.matrix(d),
+                mass: m,
+            },
             assembly,
             k_base: k,
             kd_base,
-            m,
         })
     }
 
@@ -114,7 +108,9 @@ impl LevelSystem {
     /// added before.
     pub fn set_fairness(&mut self, fairness: &StencilTable) -> Result<()> {
         let u = self.assembly.values_of(fairness)?;
-        self.kd = self.kd_base.iter().zip(&u).map(|(a, b)| a + b).collect();
+        self.implicit.base = self
+            .assembly
+            .matrix(self.kd_base.iter().zip(&u).map(|(a, b)| a + b).collect());
         self.k = self
             .assembly
             .matrix(self.k_base.iter().zip(&u).map(|(a, b)| a + b).collect());
@@ -131,11 +127,11 @@ impl LevelSystem {
                 .sum::<Real>())
     }
 
-    /// One implicit step from `p` (the previous step's positions in
-    /// `p_before`, used by the mass term) with `springs` (their matrix in
-    /// the assembly's pattern) and the explicit `load`: `p` becomes the
-    /// solution, warm-started from itself, `p_before` the positions it
-    /// left.
+    /// One implicit step ([`ImplicitSystem`]) from `p` (the previous
+    /// step's positions in `p_before`, used by the mass term) with
+    /// `springs` (their matrix in the assembly's pattern) and the explicit
+    /// `load`: `p` becomes the solution, warm-started from itself,
+    /// `p_before` the positions it left.
     pub fn step(
         &self,
         springs: SpringSystem,
@@ -144,32 +140,11 @@ impl LevelSystem {
         p_before: &mut [Point3],
         cg: &PcgParams,
     ) -> Result<PcgReport> {
-        let mut a = springs.matrix;
-        for (x, y) in a.weights.iter_mut().zip(&self.kd) {
-            *x += y;
-        }
-        let dp = self.d.apply(p)?;
-        let mut rhs: Vec<Point3> = springs
-            .rhs
-            .iter()
-            .zip(&dp)
-            .map(|(a, b)| Point3::from(a.coords + b.coords))
-            .collect();
-        if let Some(load) = load {
-            for (r, f) in rhs.iter_mut().zip(load) {
-                r.coords += f.coords;
-            }
-        }
-        if let Some(m) = &self.m {
-            let inertia: Vec<Point3> = p
-                .iter()
-                .zip(p_before.iter())
-                .map(|(a, b)| Point3::from(2.0 * a.coords - b.coords))
-                .collect();
-            for (r, x) in rhs.iter_mut().zip(m.apply(&inertia)?) {
-                r.coords += x.coords;
-            }
-        }
+        let mut terms = vec![springs.rhs.as_slice()];
+        terms.extend(load);
+        let (a, rhs) = self
+            .implicit
+            .system(Some(springs.matrix), &terms, p, p_before)?;
         p_before.copy_from_slice(p);
         pcg(&a, &rhs, p, cg)
     }
