@@ -26,7 +26,7 @@ use crate::subdivision::Refiner;
 use crate::topology::NONE;
 
 use super::Sample;
-use super::patch::CORNERS;
+use super::param::CORNERS;
 use super::patch_table::{PatchPoint, PatchTable, QuadtreeCache};
 
 /// Options of [`ClosestPointEngine::new`].

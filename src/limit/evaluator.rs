@@ -8,7 +8,8 @@ use crate::stencil::StencilTable;
 use crate::subdivision::Refiner;
 use crate::topology::{Level, Sharpness};
 
-use super::patch::{SampleStencil, evaluate_face};
+use super::local_eval::evaluate_face;
+use super::patch::SampleStencil;
 
 /// A parameter location on the control mesh: face `face` at `(u, v)`.
 ///

@@ -5,7 +5,8 @@ use crate::stencil::{RowBuilder, StencilTable};
 use crate::subdivision::Hierarchy;
 use crate::topology::{Level, Sharpness, VertexRule};
 
-use super::patch::{CORNERS, evaluate_face};
+use super::local_eval::evaluate_face;
+use super::param::CORNERS;
 use super::vertex_masks::{limit_position_mask, masks_apply};
 
 /// Rows = limit positions of the vertices of level `level`, as weights over

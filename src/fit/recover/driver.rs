@@ -14,7 +14,11 @@
 //! settles; if the 95th percentile of `|t|` is above the tolerance the
 //! control mesh is subdivided and the evolution goes on.
 
+mod judge;
+
 use std::time::Instant;
+
+use judge::{LOCAL_MISS, local_misses};
 
 use rayon::prelude::*;
 
@@ -26,9 +30,7 @@ use crate::dynamics::{
 use crate::error::{Error, Result};
 use crate::fit::ErrorStats;
 use crate::fit::Refinement;
-use crate::fit::levels::{
-    Level, LevelFit, Next, Refine, Refined, Verdict, fitted_worse, run_levels,
-};
+use crate::fit::levels::{Level, LevelFit, Next, Refine, Refined, Verdict, run_levels};
 use crate::fit::system::LevelSystem;
 use crate::forces::{
     ImageField, Offset, RowSprings, SpringSystem, inflation_force, spread_point_springs,
@@ -168,7 +170,6 @@ impl LevelFit for VolumeFit<'_> {
             params,
             ref mut progress,
             ref mut levels,
-            ref coarser,
             ..
         } = *self;
         if (0..refiner.level.num_edges()).any(|e| refiner.level.is_boundary_edge(e)) {
@@ -434,66 +435,7 @@ impl LevelFit for VolumeFit<'_> {
             boundary_points: far_from.points.len(),
             unmatched,
         });
-        // A finer level that follows the image worse than its parent on
-        // every count (a thin structure can pull the finer surface's
-        // springs across itself) is dropped and the parent returned.
-        if let ([.., before, last], Some(parent)) = (levels.as_slice(), &coarser)
-            && fitted_worse(
-                (last.offsets.rms, last.offsets.p95),
-                (before.offsets.rms, before.offsets.p95),
-            )
-            && last.unresolved >= before.unresolved
-        {
-            let reason = format!(
-                "level {level} followed the image worse than level {} (RMS offset {:.3} > {:.3} voxels, {:.1} % unresolved): level {} returned",
-                level - 1,
-                last.offsets.rms,
-                before.offsets.rms,
-                100.0 * last.unresolved,
-                level - 1
-            );
-            *mesh = parent.clone();
-            self.dropped = true;
-            return Ok(Verdict::Stop(false, reason));
-        }
-        if outside_box > 0.0 {
-            return Ok(Verdict::Stop(
-                false,
-                format!(
-                    "the surface left the volume's box at level {level}: {:.0} of its {} samples lie more than 1 voxel outside",
-                    outside_box * weights.len() as Real,
-                    weights.len()
-                ),
-            ));
-        }
-        if unresolved > params.max_unresolved {
-            return Ok(Verdict::Stop(
-                false,
-                format!(
-                    "{:.1} % of the surface found no boundary within ±{search:.1} voxels at level {level} (more than {:.0} %): finer levels would not find it",
-                    100.0 * unresolved,
-                    100.0 * params.max_unresolved
-                ),
-            ));
-        }
-        let met = (offsets.p95 <= params.tolerance_voxels
-            && !local
-            && unresolved < 0.01
-            && unmatched <= params.max_unmatched)
-            .then(|| format!("tolerance met at level {level}"));
-        // The gain counts once the surface has found its boundary.
-        let gain = match levels.as_slice() {
-            [.., before, last] if last.unresolved < 0.01 => {
-                Some((last.offsets.rms, before.offsets.rms))
-            }
-            _ => None,
-        };
-        self.off = off;
-        Ok(Verdict::Judge {
-            met,
-            gain,
-            measure: "RMS offset".into(),
-        })
+        self.judge(mesh, off, local)
     }
 
     fn refinement(&mut self, level: usize, mesh: &PolyMesh) -> Result<Refine> {
@@ -574,29 +516,6 @@ fn voxels_outside_box(volume: &crate::volume::Volume, x: &Point3) -> Real {
         .fold(0.0, Real::max)
 }
 
-/// Offsets beyond this many tolerances are a local miss.
-const LOCAL_MISS: Real = 1.2;
-
-/// At most this share of the samples for [`local_misses`].
-const LOCAL_MISS_SHARE: Real = 0.001;
-
-/// Whether the offsets `t` (voxels) hold a few local misses: samples off
-/// the boundary by more than [`LOCAL_MISS`] × `tolerance`, but at most
-/// [`LOCAL_MISS_SHARE`] of them. The 95th percentile cannot see them: they
-/// are a tip or an edge the level's cage is too coarse to reach (the
-/// anvil's horn, 0.007 % of its samples at 0.87 voxel, while its 95th
-/// percentile is 0.17), and splitting the few faces they lie on is cheap,
-/// so the level is refined there. Many such samples are a surface rough
-/// everywhere at this resolution (the MNI brain's sulci: 2.5 % beyond 0.6
-/// voxel at level 0), whose faces would all be split: the 95th percentile
-/// alone judges it. Chosen on the recovery bench's anvil, spot, bracket and
-/// the MNI T1 brain (`benches/compare/RESULTS.md`).
-fn local_misses(t: &[Real], tolerance: Real) -> bool {
-    let limit = LOCAL_MISS * tolerance;
-    let misses = t.iter().filter(|&&x| x > limit).count();
-    misses > 0 && misses as Real <= LOCAL_MISS_SHARE * t.len() as Real
-}
-
 /// Median length of the control mesh's edges at positions `p` (each face
 /// side counted once per face): a simplified cage's few long edges on flat
 /// parts would raise a mean, and with it the search range, far above the
@@ -622,26 +541,4 @@ fn gauss_points(table: &PatchTable, order: usize) -> Vec<(usize, [Real; 2])> {
     (0..table.num_patches())
         .flat_map(|f| rule.iter().map(move |&(st, _)| (f, st)))
         .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A few samples beyond 1.2 × the tolerance (a tip) refine; none, or a
-    /// share above 0.1 % (a surface rough everywhere), do not.
-    #[test]
-    fn local_misses_are_a_few_samples_beyond_the_tolerance() {
-        let mut t = vec![0.2; 10_000];
-        assert!(!local_misses(&t, 0.5));
-        t[17] = 0.87;
-        assert!(local_misses(&t, 0.5));
-        t[18] = 0.59; // within 1.2 × 0.5
-        assert!(local_misses(&t, 0.5));
-        for x in t.iter_mut().take(11) {
-            *x = 0.8;
-        }
-        assert!(!local_misses(&t, 0.5), "12 of 10,000 is more than 0.1 %");
-        assert!(!local_misses(&[], 0.5));
-    }
 }
