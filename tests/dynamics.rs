@@ -35,7 +35,7 @@ fn dense(a: &StencilTable) -> Vec<Vec<Real>> {
 }
 
 fn quad_form(a: &StencilTable, x: &[Real]) -> Real {
-    let ax = a.apply_scalar(x).unwrap();
+    let ax = a.apply(x).unwrap();
     ax.iter().zip(x).map(|(a, b)| a * b).sum()
 }
 
@@ -216,7 +216,7 @@ fn stiffness_is_psd_with_translations_in_its_null_space() {
         let k = stiffness_matrix(&q, table.to_level(), &MaterialParams::default()).unwrap();
         assert_symmetric(&k, "K");
         let ones = vec![1.0; k.num_rows()];
-        let k1 = k.apply_scalar(&ones).unwrap();
+        let k1 = k.apply(&ones).unwrap();
         let scale = k.weights.iter().fold(0.0f64, |s, w| s.max(w.abs()));
         assert!(
             k1.iter()

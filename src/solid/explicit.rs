@@ -11,7 +11,7 @@ use crate::math::Real;
 
 use super::model::Solid;
 use super::params::{ExplicitScheme, check_value};
-use super::products::{mul_transpose_vectors, solve_vectors};
+use super::products::solve_vectors;
 
 /// What one time step did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -52,7 +52,7 @@ impl Solid {
         let start = Instant::now();
         let (f, spring_energy) = self.mass_point_forces();
         if let Some(factor) = &self.part.mass_factor {
-            let g = mul_transpose_vectors(&self.part.a1, &f);
+            let g = self.part.a1.apply_transpose_parallel(&f);
             let acc = solve_vectors(factor, &g);
             for (k, &i) in self.part.free.iter().enumerate() {
                 let old = self.v[i];

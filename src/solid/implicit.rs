@@ -39,9 +39,7 @@ use crate::stencil::StencilTable;
 use super::explicit::{StepReport, check_step};
 use super::model::{PrecondFactor, Preconditioner, Solid};
 use super::params::ImplicitPreconditioner;
-use super::products::{
-    cholesky, cholesky_dense, mul_transpose_vectors, mul_vectors, solve_vectors,
-};
+use super::products::{cholesky, cholesky_dense, solve_vectors};
 use super::reduced::{BlockPattern, MAX_DENSE_UNKNOWNS, ReducedInputs, reduced_matrix};
 use super::springs::SpringHessians;
 
@@ -180,16 +178,16 @@ impl Solid {
         let mut kw = vec![Vector3::zeros(); nd];
         // b = h A₁ᵀ (f − h K ḋ), `f_minus_hkv` holding the bracket.
         let rhs_fine: Vec<Vector3> = f_minus_hkv.iter().map(|f| f * h).collect();
-        let b = mul_transpose_vectors(&self.part.a1, &rhs_fine);
+        let b = self.part.a1.apply_transpose_parallel(&rhs_fine);
         let mut w = vec![Vector3::zeros(); nd];
         let mut fine = vec![Vector3::zeros(); nd];
         let mut apply = |x: &[Vector3]| -> Vec<Vector3> {
-            mul_vectors(&self.part.a1, x, &mut w);
+            self.part.a1.apply_into(x, &mut w);
             self.stiffness_product(hess, &w, &mut kw);
             for i in 0..nd {
                 fine[i] = w[i] * (scale * self.mass[i]) + kw[i] * (h * h);
             }
-            mul_transpose_vectors(&self.part.a1, &fine)
+            self.part.a1.apply_transpose_parallel(&fine)
         };
         // Preconditioned CG, from zero with the lagged Hessian (its first
         // iterate `P⁻¹ b` is already close; a warm start would cost one more

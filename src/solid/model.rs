@@ -25,7 +25,7 @@ use crate::math::{Point3, Real, Vector3};
 use crate::stencil::StencilTable;
 
 use super::params::SolidParams;
-use super::products::{cholesky, mul_vectors};
+use super::products::cholesky;
 use super::springs::SpringNetwork;
 use super::tools::Rope;
 
@@ -200,7 +200,7 @@ impl Solid {
         self.d.resize(self.a.num_rows(), Point3::origin());
         self.dd.resize(self.a.num_rows(), Vector3::zeros());
         self.a.apply_into(&self.p, &mut self.d);
-        mul_vectors(&self.a, &self.v, &mut self.dd);
+        self.a.apply_into(&self.v, &mut self.dd);
     }
 
     /// Control-point positions `p`.

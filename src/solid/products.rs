@@ -1,65 +1,12 @@
-//! Sparse products of the solid's stencil tables with per-point vectors, and
-//! the dense matrices of the (small) control-point system.
+//! The dense matrices of the solid's (small) control-point system and their
+//! Cholesky factors (its sparse products are the stencil tables' own:
+//! [`StencilTable::apply_into`], [`StencilTable::apply_transpose_parallel`]).
 
 use nalgebra::{Cholesky, DMatrix, Dyn};
-use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::math::{Real, Vector3, reduction_parts};
+use crate::math::{Real, Vector3};
 use crate::stencil::StencilTable;
-
-/// `out = T x` for a table `T` and per-column vectors `x` (rows in parallel).
-pub fn mul_vectors(t: &StencilTable, x: &[Vector3], out: &mut [Vector3]) {
-    debug_assert_eq!(x.len(), t.num_cols);
-    out.par_iter_mut()
-        .with_min_len(512)
-        .enumerate()
-        .for_each(|(r, o)| {
-            let (c, w) = t.row(r);
-            let mut s = Vector3::zeros();
-            for (&c, &w) in c.iter().zip(w) {
-                s += w * x[c as usize];
-            }
-            *o = s;
-        });
-}
-
-/// `Tᵀ f` for a table `T` with few columns (`A₁ᵀ f`: forces on mass points
-/// to forces on control points), rows split over the workers, each
-/// accumulating into its own small buffer.
-pub fn mul_transpose_vectors(t: &StencilTable, f: &[Vector3]) -> Vec<Vector3> {
-    debug_assert_eq!(f.len(), t.num_rows());
-    let n = t.num_cols;
-    let rows = t.num_rows();
-    let parts = reduction_parts(rows, 1024);
-    let size = rows.div_ceil(parts);
-    let partial: Vec<Vec<Vector3>> = (0..parts)
-        .into_par_iter()
-        .map(|p| {
-            let mut acc = vec![Vector3::zeros(); n];
-            let r0 = p * size;
-            for (r, &fr) in f
-                .iter()
-                .enumerate()
-                .take(((p + 1) * size).min(rows))
-                .skip(r0)
-            {
-                let (c, w) = t.row(r);
-                for (&c, &w) in c.iter().zip(w) {
-                    acc[c as usize] += w * fr;
-                }
-            }
-            acc
-        })
-        .collect();
-    let mut out = vec![Vector3::zeros(); n];
-    for acc in partial {
-        for (o, a) in out.iter_mut().zip(acc) {
-            *o += a;
-        }
-    }
-    out
-}
 
 /// A square sparse table as a dense matrix.
 pub fn dense(t: &StencilTable) -> DMatrix<Real> {

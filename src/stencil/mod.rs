@@ -3,7 +3,9 @@
 
 mod assemble;
 mod csr;
+mod primvar;
 mod table;
 
 pub use assemble::Elements;
+pub use primvar::Primvar;
 pub use table::{RowBuilder, StencilTable};

@@ -6,9 +6,10 @@
 
 use rayon::prelude::*;
 
+use super::Primvar;
 use super::csr::RowAccumulator;
 use crate::error::{Error, Result};
-use crate::math::{Point3, Real, group_by_key};
+use crate::math::{Real, group_by_key, reduction_parts};
 
 /// A sparse matrix in compressed-row form with `u32` column indices.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -108,20 +109,21 @@ impl StencilTable {
         (&self.indices[a..b], &self.weights[a..b])
     }
 
-    /// Applies the table to points: `out[r] = Σ w · points[c]`.
-    pub fn apply(&self, points: &[Point3]) -> Result<Vec<Point3>> {
-        self.check_input(points.len())?;
-        let mut out = vec![Point3::origin(); self.num_rows()];
-        self.apply_into(points, &mut out);
+    /// Applies the table: `out[r] = Σ w · values[c]` (points, vectors,
+    /// scalars: any [`Primvar`]).
+    pub fn apply<T: Primvar>(&self, values: &[T]) -> Result<Vec<T>> {
+        self.check_input(values.len())?;
+        let mut out = vec![T::zero(); self.num_rows()];
+        self.apply_into(values, &mut out);
         Ok(out)
     }
 
-    /// Applies the table into a caller-provided buffer of `num_rows` points
+    /// Applies the table into a caller-provided buffer of `num_rows` values
     /// (no allocation; rows are processed in parallel).
     ///
     /// Panics if the sizes disagree; [`apply`](Self::apply) checks them first.
-    pub fn apply_into(&self, points: &[Point3], out: &mut [Point3]) {
-        assert_eq!(points.len(), self.num_cols);
+    pub fn apply_into<T: Primvar>(&self, values: &[T], out: &mut [T]) {
+        assert_eq!(values.len(), self.num_cols);
         assert_eq!(out.len(), self.num_rows());
         let rows = chunk_rows(out.len());
         out.par_chunks_mut(rows)
@@ -130,49 +132,73 @@ impl StencilTable {
                 let r0 = ci * rows;
                 for (i, o) in chunk.iter_mut().enumerate() {
                     let (a, b) = (self.offsets[r0 + i], self.offsets[r0 + i + 1]);
-                    let (mut x, mut y, mut z) = (0.0, 0.0, 0.0);
+                    let mut sum = T::zero();
                     for k in a..b {
-                        let p = &points[self.indices[k] as usize];
-                        let w = self.weights[k];
-                        x += w * p.x;
-                        y += w * p.y;
-                        z += w * p.z;
+                        sum.add_scaled(self.weights[k], &values[self.indices[k] as usize]);
                     }
-                    *o = Point3::new(x, y, z);
+                    *o = sum;
                 }
             });
     }
 
-    /// Applies the table to scalar values (one per column).
-    pub fn apply_scalar(&self, values: &[Real]) -> Result<Vec<Real>> {
-        self.check_input(values.len())?;
-        Ok((0..self.num_rows())
-            .into_par_iter()
-            .map(|r| {
-                let (c, w) = self.row(r);
-                c.iter().zip(w).map(|(&c, &w)| w * values[c as usize]).sum()
-            })
-            .collect())
-    }
-
     /// Applies the transpose: `out[c] = Σ_r w_rc · values[r]`, the map that
-    /// turns forces on samples into forces on control points (`Jᵀ f`).
-    pub fn apply_transpose(&self, values: &[Point3]) -> Result<Vec<Point3>> {
-        if values.len() != self.num_rows() {
-            return Err(Error::Input(format!(
-                "stencil table has {} rows but {} values were given",
-                self.num_rows(),
-                values.len()
-            )));
-        }
-        let mut out = vec![Point3::origin(); self.num_cols];
+    /// turns forces on samples into forces on control points (`Jᵀ f`); one
+    /// pass in row order.
+    pub fn apply_transpose<T: Primvar>(&self, values: &[T]) -> Result<Vec<T>> {
+        self.check_transpose_input(values.len())?;
+        let mut out = vec![T::zero(); self.num_cols];
         for (r, v) in values.iter().enumerate() {
             let (c, w) = self.row(r);
             for (&c, &w) in c.iter().zip(w) {
-                out[c as usize].coords += w * v.coords;
+                out[c as usize].add_scaled(w, v);
             }
         }
         Ok(out)
+    }
+
+    /// [`apply_transpose`](Self::apply_transpose) for a table with many
+    /// rows and few columns (forces on a solid's mass points to its control
+    /// points): the rows are split into parts fixed by their number alone
+    /// ([`reduction_parts`]), each summed into its own buffer in parallel,
+    /// and the buffers added in order, so the result does not depend on the
+    /// thread count.
+    ///
+    /// Panics unless there is one value per row (as [`apply_into`](Self::apply_into)).
+    pub fn apply_transpose_parallel<T: Primvar>(&self, values: &[T]) -> Vec<T> {
+        assert_eq!(values.len(), self.num_rows());
+        let (n, rows) = (self.num_cols, self.num_rows());
+        let parts = reduction_parts(rows, 1024);
+        let size = rows.div_ceil(parts);
+        let partial: Vec<Vec<T>> = (0..parts)
+            .into_par_iter()
+            .map(|p| {
+                let mut acc = vec![T::zero(); n];
+                for r in p * size..((p + 1) * size).min(rows) {
+                    let (c, w) = self.row(r);
+                    for (&c, &w) in c.iter().zip(w) {
+                        acc[c as usize].add_scaled(w, &values[r]);
+                    }
+                }
+                acc
+            })
+            .collect();
+        let mut out = vec![T::zero(); n];
+        for acc in partial {
+            for (o, a) in out.iter_mut().zip(&acc) {
+                o.add_scaled(1.0, a);
+            }
+        }
+        out
+    }
+
+    fn check_transpose_input(&self, n: usize) -> Result<()> {
+        if n != self.num_rows() {
+            return Err(Error::Input(format!(
+                "stencil table has {} rows but {n} values were given",
+                self.num_rows()
+            )));
+        }
+        Ok(())
     }
 
     /// The transposed table (`num_cols × num_rows`).
