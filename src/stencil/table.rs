@@ -173,10 +173,16 @@ impl StencilTable {
             .into_par_iter()
             .map(|p| {
                 let mut acc = vec![T::zero(); n];
-                for r in p * size..((p + 1) * size).min(rows) {
+                let r0 = p * size;
+                for (r, v) in values
+                    .iter()
+                    .enumerate()
+                    .take(((p + 1) * size).min(rows))
+                    .skip(r0)
+                {
                     let (c, w) = self.row(r);
                     for (&c, &w) in c.iter().zip(w) {
-                        acc[c as usize].add_scaled(w, &values[r]);
+                        acc[c as usize].add_scaled(w, v);
                     }
                 }
                 acc
