@@ -11,6 +11,15 @@ pub trait Primvar: Copy + Send + Sync {
     fn zero() -> Self;
     /// `self += w · x`.
     fn add_scaled(&mut self, w: Real, x: &Self);
+
+    /// `Σ_k w[k] · values[cols[k]]`, in order: one row of a table.
+    fn combine(cols: &[u32], w: &[Real], values: &[Self]) -> Self {
+        let mut sum = Self::zero();
+        for (&c, &w) in cols.iter().zip(w) {
+            sum.add_scaled(w, &values[c as usize]);
+        }
+        sum
+    }
 }
 
 impl Primvar for Point3 {
@@ -21,6 +30,20 @@ impl Primvar for Point3 {
         self.x += w * x.x;
         self.y += w * x.y;
         self.z += w * x.z;
+    }
+
+    /// The same sums on three scalars held in registers: through
+    /// `add_scaled` on a `Point3` the row loop ran at half the speed
+    /// (`bench subdivide`'s stencil application, 0.035 against 0.018 s).
+    fn combine(cols: &[u32], w: &[Real], values: &[Self]) -> Self {
+        let (mut x, mut y, mut z) = (0.0, 0.0, 0.0);
+        for (&c, &w) in cols.iter().zip(w) {
+            let p = &values[c as usize];
+            x += w * p.x;
+            y += w * p.y;
+            z += w * p.z;
+        }
+        Point3::new(x, y, z)
     }
 }
 

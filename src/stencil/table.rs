@@ -132,11 +132,7 @@ impl StencilTable {
                 let r0 = ci * rows;
                 for (i, o) in chunk.iter_mut().enumerate() {
                     let (a, b) = (self.offsets[r0 + i], self.offsets[r0 + i + 1]);
-                    let mut sum = T::zero();
-                    for k in a..b {
-                        sum.add_scaled(self.weights[k], &values[self.indices[k] as usize]);
-                    }
-                    *o = sum;
+                    *o = T::combine(&self.indices[a..b], &self.weights[a..b], values);
                 }
             });
     }
