@@ -165,6 +165,51 @@ fn outliers_do_not_pull_the_surface() {
     );
 }
 
+/// The stop rules judge the points kept in the springs: 5 % outliers, whose
+/// distances are the 95th percentile of all points, do not drive the fit to
+/// its last level.
+#[test]
+fn outliers_do_not_decide_the_levels() {
+    let diag = 2.0 * 3f64.sqrt();
+    let clean = sphere_scan(4000, 0.001 * diag, 5);
+    let mut noisy = clean.clone();
+    let mut rng = Rng(7);
+    for _ in 0..200 {
+        let p = Vector3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 3.0
+            - Vector3::new(1.5, 1.5, 1.5);
+        noisy.positions.push(Point3::from(p));
+    }
+    let params = FitParams {
+        max_level: 3,
+        ..Default::default()
+    };
+    let fit = |cloud: &PointCloud| {
+        fit_point_cloud(cloud, &cube_cage(), &params, &mut |_, _, _| {})
+            .unwrap()
+            .report
+    };
+    let (a, b) = (fit(&clean), fit(&noisy));
+    assert!(
+        a.levels.len() <= 3,
+        "the clean sphere took {} levels",
+        a.levels.len()
+    );
+    assert_eq!(
+        a.levels.len(),
+        b.levels.len(),
+        "levels without and with outliers (stops: {:?} / {:?})",
+        a.stop_reason,
+        b.stop_reason
+    );
+    let (kept, all) = (b.levels.last().unwrap().kept_error, b.levels.last().unwrap().error);
+    assert!(
+        all.p95_pct > 1.2 * kept.p95_pct,
+        "p95 of all points {} %, of the kept {} %",
+        all.p95_pct,
+        kept.p95_pct
+    );
+}
+
 #[test]
 fn bad_inputs_are_errors() {
     let cage = cube_cage();

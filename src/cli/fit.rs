@@ -62,7 +62,7 @@ pub struct FitArgs {
     /// `open`, `occupancy`.
     #[arg(long, value_name = "MESH|METHOD", default_value = "auto")]
     pub init: String,
-    /// Tolerance in % of the scan's bounding-box diagonal.
+    /// Tolerance in % of the scan's bounding-box diagonal, on the distances of the points kept (outliers left out).
     #[arg(long, value_name = "PCT", default_value_t = 0.1)]
     pub tol: f64,
     /// Statistic the tolerance applies to.
@@ -362,13 +362,17 @@ fn summary(name: &str, r: &FitReport) -> String {
             l.steps,
             l.cg_iterations,
             l.seconds,
-            l.error.max_pct,
-            l.error.p95_pct,
-            l.error.rms_pct,
-            l.error.mean_pct,
+            l.kept_error.max_pct,
+            l.kept_error.p95_pct,
+            l.kept_error.rms_pct,
+            l.kept_error.mean_pct,
             l.refinement
         ));
     }
-    s.push_str("errors are data-to-surface distances from all points (outliers included) in % of the scan's bounding-box diagonal\n");
+    if r.outliers > 0 {
+        s.push_str("errors are data-to-surface distances from the points kept (the outliers left out are not counted; the report's `error` counts them) in % of the scan's bounding-box diagonal\n");
+    } else {
+        s.push_str("errors are data-to-surface distances from all points in % of the scan's bounding-box diagonal\n");
+    }
     s
 }

@@ -235,15 +235,15 @@ impl LevelFit for CloudFit<'_> {
         if let (Some((parent, parent_creases)), Some(before)) =
             (adaptive_parent.take(), levels.last())
             && fitted_worse(
-                (report.error.rms, report.error.p95),
-                (before.error.rms, before.error.p95),
+                (report.kept_error.rms, report.kept_error.p95),
+                (before.kept_error.rms, before.kept_error.p95),
             )
         {
             // Transitions on a coarse mesh can bend the surface more than the
             // split faces gain; refine the parent uniformly instead.
             *refinement = format!(
                 "uniform, after an adaptive level ({} control points) that fitted worse than its parent (95th percentile {:.3} % against {:.3} %)",
-                report.control_points, report.error.p95_pct, before.error.p95_pct
+                report.control_points, report.kept_error.p95_pct, before.kept_error.p95_pct
             );
             *carried_hints = None;
             let h = Refiner::new(&parent, &crease_options(&parent_creases))?.refine_uniform(1)?;
@@ -272,8 +272,8 @@ impl LevelFit for CloudFit<'_> {
             let with = levels.pop().expect("the level just pushed");
             let smooth = without.report;
             let dropped = fitted_worse(
-                (with.error.rms, with.error.p95),
-                (smooth.error.rms, smooth.error.p95),
+                (with.kept_error.rms, with.kept_error.p95),
+                (smooth.kept_error.rms, smooth.kept_error.p95),
             );
             let refinement = format!(
                 "{}; {} crease edges {} (95th percentile {:.3} % with, {:.3} % without)",
@@ -284,8 +284,8 @@ impl LevelFit for CloudFit<'_> {
                 } else {
                     "tagged"
                 },
-                with.error.p95_pct,
-                smooth.error.p95_pct
+                with.kept_error.p95_pct,
+                smooth.kept_error.p95_pct
             );
             let work = (
                 with.steps + smooth.steps,
@@ -352,7 +352,7 @@ impl LevelFit for CloudFit<'_> {
         }
         // The kept fit's error (the level without creases, should they
         // have been dropped).
-        let error = levels[levels.len() - 1].error;
+        let error = levels[levels.len() - 1].kept_error;
         let stat = params.tolerance_stat;
         let noise_pct = 100.0 * data_noise / diameter;
         let met = if error.pct(stat) <= params.tolerance_pct {
@@ -372,7 +372,7 @@ impl LevelFit for CloudFit<'_> {
         // percentile by default), which outliers do not dominate as they do
         // the RMS.
         let gain = match levels.as_slice() {
-            [.., before, last] => Some((last.error.pct(stat), before.error.pct(stat))),
+            [.., before, last] => Some((last.kept_error.pct(stat), before.kept_error.pct(stat))),
             _ => None,
         };
         self.residuals = Some(residuals);

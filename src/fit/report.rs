@@ -104,6 +104,11 @@ pub struct LevelReport {
     pub points_used: usize,
     /// Distances from all data points to the surface at the end of the level.
     pub error: ErrorStats,
+    /// The same distances of the points kept in the springs (without the
+    /// outliers left out, [`FitReport::outliers`]): the stop rules and the
+    /// comparisons between fits of a level judge these, as a few percent of
+    /// outliers would otherwise decide the 95th percentile.
+    pub kept_error: ErrorStats,
     /// Fraction of data points whose robust weight is zero (rejected
     /// outliers; always 0 with Huber's kernel, the default, which rejects
     /// none: the outliers it would see are left out before the fit, see

@@ -279,6 +279,8 @@ impl CloudFit<'_> {
         }
         let w = robust_weights(&dist, params.robust, 1e-6 * diameter);
         let error = ErrorStats::new(&dist, diameter);
+        let kept: Vec<Real> = self.data_index.iter().map(|&i| dist[i]).collect();
+        let kept_error = ErrorStats::new(&kept, diameter);
         mesh.positions = p;
         let report = LevelReport {
             level,
@@ -295,6 +297,7 @@ impl CloudFit<'_> {
             step_rms_pct,
             step_p95_pct,
             error,
+            kept_error,
             points_used: used.len(),
             rejected: w.iter().filter(|&&w| w == 0.0).count() as Real / n_all,
             refinement: std::mem::take(refinement),
