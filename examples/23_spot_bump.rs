@@ -49,7 +49,7 @@ fn main() -> subdyn::Result<()> {
     // body at 65 % of its length from the nose), and the lattice cell
     // holding it (by the cells' vertex boxes; they are axis-aligned here).
     let (lo, hi) = subdyn::math::bounding_box(&model.positions)
-        .ok_or_else(|| subdyn::Error::Input("empty model".into()))?;
+        .ok_or_else(|| subdyn::Error::input("empty model"))?;
     let z = lo.z + 0.65 * (hi.z - lo.z);
     let top = model
         .positions
@@ -57,7 +57,7 @@ fn main() -> subdyn::Result<()> {
         .copied()
         .filter(|p| (p.z - z).abs() < 0.02 * d)
         .max_by(|a, b| a.y.total_cmp(&b.y))
-        .ok_or_else(|| subdyn::Error::Input("no vertex in the slice".into()))?;
+        .ok_or_else(|| subdyn::Error::input("no vertex in the slice"))?;
     let t = &lat.topology;
     let cell = (0..t.num_cells())
         .find(|&c| {
@@ -70,7 +70,7 @@ fn main() -> subdyn::Result<()> {
                 (lo..=hi).contains(&top[k])
             })
         })
-        .ok_or_else(|| subdyn::Error::Input("no lattice cell holds the top vertex".into()))?;
+        .ok_or_else(|| subdyn::Error::input("no lattice cell holds the top vertex"))?;
     println!("bump centre {top:?}");
     let (local, report) = locally_refined(&lat, &[cell])?;
     println!(

@@ -77,7 +77,7 @@ fn main() -> subdyn::Result<()> {
                     .iter()
                     .all(|&v| lat.positions[v as usize].y > 0.99)
         })
-        .ok_or_else(|| subdyn::Error::Input("no top face".into()))?;
+        .ok_or_else(|| subdyn::Error::input("no top face"))?;
     solid.extrude(top)?;
     for _ in 0..100 {
         solid.step_implicit(h)?;

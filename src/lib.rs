@@ -75,4 +75,4 @@ pub mod subdivision;
 pub mod topology;
 pub mod volume;
 
-pub use error::{Error, Result};
+pub use error::{Error, InputError, InputKind, Result};

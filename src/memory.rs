@@ -83,7 +83,7 @@ pub fn parse_memory_size(text: &str) -> Result<u64> {
     };
     match number.trim().parse::<f64>() {
         Ok(x) if x.is_finite() && x * scale >= 1.0 && x * scale < 1.8e19 => Ok((x * scale) as u64),
-        _ => Err(Error::Input(format!(
+        _ => Err(Error::input(format!(
             "memory size {text:?}: expected a positive number of bytes, optionally with k, M, G or T (such as 2G)"
         ))),
     }

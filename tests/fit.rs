@@ -201,7 +201,10 @@ fn outliers_do_not_decide_the_levels() {
         a.stop_reason,
         b.stop_reason
     );
-    let (kept, all) = (b.levels.last().unwrap().kept_error, b.levels.last().unwrap().error);
+    let (kept, all) = (
+        b.levels.last().unwrap().kept_error,
+        b.levels.last().unwrap().error,
+    );
     assert!(
         all.p95_pct > 1.2 * kept.p95_pct,
         "p95 of all points {} %, of the kept {} %",

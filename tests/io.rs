@@ -198,6 +198,40 @@ fn writers_check_their_input() {
     ));
 }
 
+/// A caller can match on the kind of bad input, the message unchanged.
+#[test]
+fn input_errors_have_kinds() {
+    use subdyn::InputKind;
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = sample_mesh();
+    let path = dir.path().join("bad.obj");
+    let kind = |r: subdyn::Result<()>| r.unwrap_err().input_kind();
+    let short = sample_normals(3);
+    assert_eq!(
+        kind(write_mesh(&path, &mesh, Some(&short))),
+        Some(InputKind::SizeMismatch)
+    );
+    let mut nan = sample_normals(mesh.num_vertices());
+    nan[2].y = f64::NAN;
+    let e = write_mesh(&path, &mesh, Some(&nan)).unwrap_err();
+    assert_eq!(e.input_kind(), Some(InputKind::NonFinite));
+    assert_eq!(e.to_string(), "input: normal 2 is not finite");
+    assert_eq!(
+        kind(write_mesh(dir.path().join("mesh.stl"), &mesh, None)),
+        Some(InputKind::Unsupported)
+    );
+    let refiner = subdyn::subdivision::Refiner::new(&mesh, &Default::default()).unwrap();
+    let eval = subdyn::limit::LimitEvaluator::new(&refiner);
+    let e = eval.stencil(mesh.num_faces(), 0.5, 0.5).unwrap_err();
+    assert_eq!(e.input_kind(), Some(InputKind::OutOfRange), "{e}");
+    assert!(
+        read_mesh(dir.path().join("missing.obj"))
+            .unwrap_err()
+            .input_kind()
+            .is_none()
+    );
+}
+
 // ---------------------------------------------------------------------- OBJ
 
 #[test]

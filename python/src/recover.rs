@@ -178,7 +178,7 @@ pub fn recover<'py>(
                 "evolution": result.report.levels.iter().map(|l| l.seconds).sum::<f64>(),
             },
             "recover": serde_json::to_value(&result.report)
-                .map_err(|e| subdyn::Error::Input(format!("the report cannot be serialised: {e}")))?,
+                .map_err(|e| subdyn::Error::input(format!("the report cannot be serialised: {e}")))?,
             "poor_result": problems,
             "total_s": started.elapsed().as_secs_f64(),
         });

@@ -154,7 +154,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
     let (result, compare_s) = timed(|| match (&a, &sa) {
         (Side::Points(cloud), _) => compare_points(&cloud.positions, cloud.normals.as_deref(), &sb),
         (Side::Mesh(_), Some(sa)) => compare(sa, &sb, &params),
-        (Side::Mesh(_), None) => Err(subdyn::Error::Input("no surface for A".into())),
+        (Side::Mesh(_), None) => Err(subdyn::Error::input("no surface for A")),
     });
     let c = result?;
     drop(progress);

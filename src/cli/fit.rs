@@ -288,18 +288,18 @@ fn write_plot(path: &Path, report: &FitReport, params: &FitParams) -> anyhow::Re
         });
     }
     series.push(Series {
-        label: "p95, all points".into(),
+        label: "p95, kept points".into(),
         points: report
             .levels
             .iter()
-            .map(|l| (l.elapsed, l.error.p95_pct.max(1e-9)))
+            .map(|l| (l.elapsed, l.kept_error.p95_pct.max(1e-9)))
             .collect(),
         color: [0, 0, 0],
     });
     let title = format!(
-        "fit error: colours = the inliers the springs used ({} outliers left out); black = all {} points, as in the table",
+        "fit error: colours = the inliers the springs used ({} outliers left out); black = all {} of them at the end of each level, as in the table",
         thousands(report.outliers),
-        thousands(report.points)
+        thousands(report.points - report.outliers)
     );
     let options = PlotOptions {
         title: Some(title),

@@ -58,7 +58,7 @@ pub fn patch_matrices(
 ) -> Result<[StencilTable; 3]> {
     let faces = table.num_base_faces();
     if materials.len() != 1 && materials.len() != faces {
-        return Err(Error::Input(format!(
+        return Err(Error::size_mismatch(format!(
             "{} materials for a control mesh of {faces} faces: give one, or one per face",
             materials.len()
         )));
@@ -66,7 +66,9 @@ pub fn patch_matrices(
     let uniform = materials.len() == 1;
     for (f, m) in materials.iter().enumerate() {
         m.check().map_err(|e| match e {
-            Error::Input(what) if !uniform => Error::Input(format!("face {f}'s {what}")),
+            Error::Input(what) if !uniform => {
+                Error::with_kind(what.kind(), format!("face {f}'s {what}"))
+            }
             e => e,
         })?;
     }
@@ -231,7 +233,7 @@ fn elements<const N: usize>(
     c: [[Real; 6]; N],
 ) -> Result<PatchElements<N>> {
     if order == 0 || order > 16 {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "quadrature order {order} must be between 1 and 16"
         )));
     }

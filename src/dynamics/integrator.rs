@@ -89,12 +89,12 @@ impl SurfaceDynamics {
             check_size(name, m, n)?;
         }
         if !(dt > 0.0 && dt.is_finite()) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "dynamics: time step {dt} must be positive"
             )));
         }
         if let Some(i) = first_non_finite(&positions) {
-            return Err(Error::Input(format!(
+            return Err(Error::non_finite(format!(
                 "dynamics: control point {i} is not finite"
             )));
         }
@@ -149,7 +149,7 @@ impl SurfaceDynamics {
     /// Sets the control points (a jump: the surface is at rest there).
     pub fn set_positions(&mut self, positions: &[Point3]) -> Result<()> {
         if positions.len() != self.p.len() {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "dynamics: {} positions for {} control points",
                 positions.len(),
                 self.p.len()
@@ -246,13 +246,13 @@ impl SurfaceDynamics {
     fn check_load(&self, springs: Option<&StencilTable>, load: &[Point3]) -> Result<()> {
         let n = self.p.len();
         if load.len() != n {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "dynamics: a load of {} vectors for {n} control points",
                 load.len()
             )));
         }
         if let Some(i) = first_non_finite(load) {
-            return Err(Error::Input(format!(
+            return Err(Error::non_finite(format!(
                 "dynamics: the load on control point {i} is not finite"
             )));
         }
@@ -263,7 +263,7 @@ impl SurfaceDynamics {
 /// An error unless `m` (when given) is `n × n`.
 fn check_size(name: &str, m: Option<&StencilTable>, n: usize) -> Result<()> {
     match m {
-        Some(m) if m.num_rows() != n || m.num_cols != n => Err(Error::Input(format!(
+        Some(m) if m.num_rows() != n || m.num_cols != n => Err(Error::size_mismatch(format!(
             "dynamics: the {name} matrix is {} × {} for {n} control points",
             m.num_rows(),
             m.num_cols

@@ -85,7 +85,7 @@ impl MaterialParams {
             ("beta22", self.beta22),
         ];
         match all.iter().find(|(_, v)| !(v.is_finite() && *v >= 0.0)) {
-            Some((name, v)) => Err(Error::Input(format!(
+            Some((name, v)) => Err(Error::input(format!(
                 "material parameter {name} = {v}: must be finite and ≥ 0"
             ))),
             None => Ok(()),
@@ -166,7 +166,7 @@ fn area_weighted_gram(
         None => q.weights.iter().map(|w| (density * w).sqrt()).collect(),
         Some(x) => {
             if x.len() != s.num_rows() {
-                return Err(Error::Input(format!(
+                return Err(Error::size_mismatch(format!(
                     "{} level positions for a refinement of {} points",
                     x.len(),
                     s.num_rows()

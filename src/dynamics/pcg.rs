@@ -53,7 +53,7 @@ pub fn pcg(
 ) -> Result<PcgReport> {
     let n = a.num_rows();
     if a.num_cols != n || b.len() != n || x.len() != n {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "pcg: matrix {}×{}, right-hand side {}, initial guess {}",
             n,
             a.num_cols,
@@ -62,7 +62,7 @@ pub fn pcg(
         )));
     }
     if !(params.tolerance > 0.0 && params.tolerance.is_finite()) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "pcg tolerance {} must be positive",
             params.tolerance
         )));
@@ -70,7 +70,7 @@ pub fn pcg(
     let start = Instant::now();
     let diag = a.diagonal();
     if let Some(i) = diag.iter().position(|&d| !(d > 0.0 && d.is_finite())) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "pcg: diagonal entry {i} is {}, so the matrix is not positive definite (an unknown that \
              nothing touches, such as an isolated vertex of the mesh, has no mass or stiffness)",
             diag[i]

@@ -90,7 +90,7 @@ pub fn patch_samples(table: &PatchTable, order: usize) -> Result<Quadrature> {
 
 fn quadrature_on(table: &PatchTable, order: usize, per_piece: bool) -> Result<Quadrature> {
     if order == 0 || order > 16 {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "quadrature order {order} must be between 1 and 16"
         )));
     }

@@ -48,7 +48,7 @@ type Part = ([(Vec<usize>, Vec<u32>, Vec<Real>); 2], Vec<Real>, Vec<u32>);
 /// points.
 pub fn patch_sample_rows(table: &PatchTable, order: usize) -> Result<SampleRows> {
     if order == 0 || order > 16 {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "quadrature order {order} must be between 1 and 16"
         )));
     }

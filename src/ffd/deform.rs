@@ -85,19 +85,18 @@ impl Ffd {
     /// Refines the lattice, embeds the points and forms `B` (the precompute step).
     pub fn new(lattice: &Lattice, points: &[Point3], params: &FfdParams) -> Result<Ffd> {
         if params.levels == 0 {
-            return Err(Error::Input(
-                "FFD needs at least one refinement level (level-0 cells are arbitrary polyhedra)"
-                    .into(),
+            return Err(Error::input(
+                "FFD needs at least one refinement level (level-0 cells are arbitrary polyhedra)",
             ));
         }
         if params.levels > MAX_LATTICE_LEVELS {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "{} lattice levels requested; at most {MAX_LATTICE_LEVELS} are allowed (cells grow eightfold per level)",
                 params.levels
             )));
         }
         if !(params.slack.is_finite() && params.slack >= 0.0) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "slack {} must be a finite number ≥ 0",
                 params.slack
             )));
@@ -106,7 +105,7 @@ impl Ffd {
             .iter()
             .position(|p| !p.coords.iter().all(|x| x.is_finite()))
         {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "model vertex {i}: coordinate is not a finite number"
             )));
         }
@@ -168,7 +167,7 @@ impl Ffd {
     pub fn set_control(&mut self, p: &[Point3]) -> Result<()> {
         check_finite(p)?;
         if p.len() != self.control.len() {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "{} control points given, the lattice has {}",
                 p.len(),
                 self.control.len()
@@ -189,13 +188,13 @@ impl Ffd {
         let mut touched = 0;
         for &(c, q) in moves {
             if c >= self.control.len() {
-                return Err(Error::Input(format!(
+                return Err(Error::out_of_range(format!(
                     "control point {c} does not exist (the lattice has {})",
                     self.control.len()
                 )));
             }
             if !q.coords.iter().all(|x| x.is_finite()) {
-                return Err(Error::Input(format!(
+                return Err(Error::non_finite(format!(
                     "control point {c}: new position is not finite"
                 )));
             }
@@ -218,7 +217,7 @@ fn check_finite(p: &[Point3]) -> Result<()> {
         .iter()
         .position(|q| !q.coords.iter().all(|x| x.is_finite()))
     {
-        Some(i) => Err(Error::Input(format!(
+        Some(i) => Err(Error::input(format!(
             "control point {i}: coordinate is not a finite number"
         ))),
         None => Ok(()),

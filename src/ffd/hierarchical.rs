@@ -52,7 +52,7 @@ impl LayeredFfd {
         params: &FfdParams,
     ) -> Result<LayeredFfd> {
         if model_now.len() != model_rest.len() || control.len() != rest.num_vertices() {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "hierarchical FFD: {} current and {} rest model vertices, {} control points for a lattice of {}",
                 model_now.len(),
                 model_rest.len(),
@@ -72,7 +72,7 @@ impl LayeredFfd {
         control: Vec<Point3>,
     ) -> Result<LayeredFfd> {
         if model_now.len() != ffd.rest.len() || control.len() != rest.num_vertices() {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "hierarchical FFD: {} model vertices for an embedding of {}, {} control points for a lattice of {}",
                 model_now.len(),
                 ffd.rest.len(),

@@ -77,7 +77,7 @@ pub fn conversion_weight(n: usize, k: usize) -> Real {
 /// ```
 pub fn doo_sabin_to_non_uniform(mesh: &PolyMesh, epsilon: Real) -> Result<Conversion> {
     if !epsilon.is_finite() || !(0.0..=1.0).contains(&epsilon) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "the small knot interval must be in [0, 1], got {epsilon}"
         )));
     }

@@ -149,15 +149,16 @@ impl CurveFinetune {
     ) -> Result<Self> {
         check_params(params)?;
         if let Some(i) = first_non_finite(points) {
-            return Err(Error::Input(format!("control point {i} is not finite")));
+            return Err(Error::non_finite(format!(
+                "control point {i} is not finite"
+            )));
         }
         let exact = exact_finetune(topology, points, alpha)?;
-        let (lo, hi) =
-            bounding_box(points).ok_or_else(|| Error::Input("no control points".into()))?;
+        let (lo, hi) = bounding_box(points).ok_or_else(|| Error::input("no control points"))?;
         let extent = (hi - lo).amax();
         let size = (hi - lo).norm();
         if !(extent > 0.0 && extent.is_finite()) {
-            return Err(Error::Input("all control points coincide".into()));
+            return Err(Error::input("all control points coincide"));
         }
         let closed = if topology.closed {
             let identity = ScalarFunction::constant(topology, alpha.degree, 1.0)?;
@@ -297,7 +298,7 @@ impl CurveFinetune {
         // fixed-period restarts were slower on the test curves.
         let line_search = MoreThuenteLineSearch::new()
             .with_c(1e-4, 0.1)
-            .map_err(|e| Error::Input(format!("line search: {e}")))?;
+            .map_err(|e| Error::input(format!("line search: {e}")))?;
         let ncg = NonlinearConjugateGradient::new(line_search, PolakRibierePlus::new());
         let solver = Converging {
             inner: ncg,
@@ -342,13 +343,13 @@ impl CurveFinetune {
 fn check_params(p: &CurveFinetuneParams) -> Result<()> {
     let ok = |x: Real| x.is_finite() && x >= 0.0;
     if !(ok(p.k_length) && ok(p.k_angle) && p.k_length + p.k_angle > 0.0) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "spring coefficients must be finite, non-negative and not both zero (k_l = {}, k_a = {})",
             p.k_length, p.k_angle
         )));
     }
     if !(p.gradient_tolerance.is_finite() && p.gradient_tolerance > 0.0) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "the gradient tolerance must be positive, got {}",
             p.gradient_tolerance
         )));

@@ -76,7 +76,7 @@ pub fn alpha_from_values(
     values: &[Real],
 ) -> Result<ScalarFunction> {
     if !(1..=3).contains(&alpha_degree) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "the degree of α must be 1, 2 or 3, got {alpha_degree}"
         )));
     }
@@ -86,7 +86,7 @@ pub fn alpha_from_values(
         ValuesOn::Vertices => topo.num_points,
     };
     if values.len() != count {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "α of degree {alpha_degree} on a degree-{} curve takes one value per {}: expected {count}, got {}",
             topo.degree(),
             if on == ValuesOn::Edges {
@@ -102,7 +102,7 @@ pub fn alpha_from_values(
         .enumerate()
         .find(|(_, v)| !(v.is_finite() && **v > 0.0 && **v <= MAX_VALUE))
     {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "control value {i} is {v}; values must be positive, finite and at most {MAX_VALUE}"
         )));
     }

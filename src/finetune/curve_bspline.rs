@@ -24,19 +24,17 @@ impl BSplineCurve {
     pub fn new(degree: usize, knots: Vec<Real>, control_points: Vec<Point3>) -> Result<Self> {
         let n = control_points.len();
         if n < degree + 1 || knots.len() != n + degree + 1 {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "a degree-{degree} B-spline with {n} control points needs {} knots, got {}",
                 n + degree + 1,
                 knots.len()
             )));
         }
         if knots.iter().any(|k| !k.is_finite()) || knots.windows(2).any(|w| w[1] < w[0]) {
-            return Err(Error::Input(
-                "knots must be finite and non-decreasing".into(),
-            ));
+            return Err(Error::input("knots must be finite and non-decreasing"));
         }
         if (1..n).any(|i| knots[i + degree] <= knots[i]) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "an interior knot has multiplicity above the degree {degree}"
             )));
         }
@@ -90,9 +88,7 @@ impl BSplineCurve {
     pub fn derivative_curve(&self) -> Result<BSplineCurve> {
         let d = self.degree;
         if d == 0 {
-            return Err(Error::Input(
-                "a degree-0 curve has no derivative curve".into(),
-            ));
+            return Err(Error::input("a degree-0 curve has no derivative curve"));
         }
         let points = self
             .control_points

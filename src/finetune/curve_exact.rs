@@ -67,7 +67,7 @@ pub fn finetuned_spans(
     alpha: &ScalarFunction,
 ) -> Result<Vec<Vec<Point3>>> {
     if points.len() != topo.num_points || alpha.closed != topo.closed {
-        return Err(Error::Input(format!(
+        return Err(Error::size_mismatch(format!(
             "{} control points and a {} α for a {} curve of {} points",
             points.len(),
             if alpha.closed { "closed" } else { "open" },
@@ -152,7 +152,7 @@ pub fn spline_from_spans(spans: &[Vec<Point3>], m: usize) -> Result<BSplineCurve
 pub fn closed_spline(periodic: &[Point3], degree: usize, m: usize) -> Result<BSplineCurve> {
     let n_total = periodic.len() as isize;
     if n_total == 0 || !periodic.len().is_multiple_of(m) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "{} periodic control points are not a multiple of the knot multiplicity {m}",
             periodic.len()
         )));

@@ -43,7 +43,7 @@ pub fn leg_frames(
 ) -> Result<(Vec<LegFrame>, Vec<Real>)> {
     let n = points.len();
     if fixed >= n {
-        return Err(Error::Input(format!(
+        return Err(Error::out_of_range(format!(
             "fixed point {fixed} is out of range: the fine-tuned polygon has {n} control points"
         )));
     }
@@ -51,7 +51,7 @@ pub fn leg_frames(
         .map(|t| points[(fixed + t + 1) % n] - points[(fixed + t) % n])
         .collect();
     let u = legs[0].try_normalize(1e-12).ok_or_else(|| {
-        Error::Input(format!("the leg after fixed point {fixed} has zero length"))
+        Error::input(format!("the leg after fixed point {fixed} has zero length"))
     })?;
     let plane_leg = if planar {
         None
@@ -60,10 +60,7 @@ pub fn leg_frames(
             let d = legs[t];
             (d - d.dot(&u) * u).try_normalize(1e-9).map(|w| (t, w))
         });
-        Some(
-            found
-                .ok_or_else(|| Error::Input("the fine-tuned polygon is a straight line".into()))?,
-        )
+        Some(found.ok_or_else(|| Error::input("the fine-tuned polygon is a straight line"))?)
     };
     let mut frames = Vec::with_capacity(n - 1);
     let mut start = Vec::with_capacity(3 * n);

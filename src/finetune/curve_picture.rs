@@ -79,7 +79,7 @@ pub fn curve_picture(
     let mut picture = Picture::new(width, height, [255, 255, 255])?;
     let all: Vec<&Point3> = layers.iter().flat_map(|l| l.points.iter()).collect();
     if all.is_empty() || all.iter().any(|p| !(p.x.is_finite() && p.y.is_finite())) {
-        return Err(Error::Input("nothing finite to draw".into()));
+        return Err(Error::input("nothing finite to draw"));
     }
     let (mut x0, mut x1, mut y0, mut y1) = (Real::MAX, Real::MIN, Real::MAX, Real::MIN);
     for p in &all {

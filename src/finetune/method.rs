@@ -21,7 +21,7 @@ impl std::str::FromStr for FinetuneMethod {
         match s {
             "lm" => Ok(FinetuneMethod::LevenbergMarquardt),
             "ncg" => Ok(FinetuneMethod::NonlinearCg),
-            _ => Err(crate::error::Error::Input(format!(
+            _ => Err(crate::error::Error::input(format!(
                 "unknown method {s:?}: expected lm or ncg"
             ))),
         }

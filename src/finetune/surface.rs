@@ -116,7 +116,7 @@ pub struct SurfaceFineTune {
 
 fn check_params(p: &SurfaceFineTuneParams) -> Result<()> {
     if p.k.iter().any(|k| !k.is_finite() || *k < 0.0) || p.k.iter().all(|k| *k == 0.0) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "spring coefficients must be finite, ≥ 0 and not all 0, got {:?}",
             p.k
         )));
@@ -127,8 +127,8 @@ fn check_params(p: &SurfaceFineTuneParams) -> Result<()> {
         || p.energy_tolerance < 0.0
         || p.max_iters > 1_000_000
     {
-        return Err(Error::Input(
-            "gradient tolerance must be ≥ 0 and at most 1,000,000 iterations".into(),
+        return Err(Error::input(
+            "gradient tolerance must be ≥ 0 and at most 1,000,000 iterations",
         ));
     }
     Ok(())
@@ -152,17 +152,17 @@ impl SurfaceFineTune {
         let mut orig_value = vec![1.0; original.num_edges()];
         for &(i, j, a) in values {
             let e = find_edge(&original, i, j).ok_or_else(|| {
-                Error::Input(format!("vertices {i} and {j} are not joined by an edge"))
+                Error::input(format!("vertices {i} and {j} are not joined by an edge"))
             })?;
             if !a.is_finite() || a <= 0.0 {
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "edge {i}-{j}: control value {a} must be finite and > 0"
                 )));
             }
             orig_value[e] = a;
         }
         if let Some(&v) = fixed.iter().find(|&&v| v as usize >= mesh.num_vertices()) {
-            return Err(Error::Input(format!(
+            return Err(Error::out_of_range(format!(
                 "fixed vertex {v} does not exist (the mesh has {} vertices)",
                 mesh.num_vertices()
             )));

@@ -211,7 +211,7 @@ pub fn minimise(
     }
     let linesearch = MoreThuenteLineSearch::new()
         .with_c(1e-4, 0.1)
-        .map_err(|e| Error::Input(e.to_string()))?;
+        .map_err(|e| Error::input(e.to_string()))?;
     let nlcg = NonlinearConjugateGradient::new(linesearch, PolakRibierePlus::new())
         .restart_iters(50)
         .restart_orthogonality(0.1);

@@ -117,22 +117,20 @@ impl<'a> CloudFit<'a> {
         params.check()?;
         let points = &cloud.positions;
         if points.len() < 4 {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "the point cloud has {} points; fitting needs at least 4",
                 points.len()
             )));
         }
         let diameter = bbox_diagonal(points);
         if !(diameter > 0.0 && diameter.is_finite()) {
-            return Err(Error::Input(
-                "all points coincide: the cloud has no extent".into(),
-            ));
+            return Err(Error::input("all points coincide: the cloud has no extent"));
         }
         let start = Instant::now();
         // The springs' data: the points without the outliers.
         let (mut keep, data_noise) = match screening {
             Some(s) if s.keep.len() != points.len() => {
-                return Err(Error::Input(format!(
+                return Err(Error::size_mismatch(format!(
                     "an outlier screening of {} points for a cloud of {}",
                     s.keep.len(),
                     points.len()

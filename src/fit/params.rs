@@ -263,7 +263,7 @@ impl FitParams {
     /// Checks every value; the error names the parameter.
     pub fn check(&self) -> Result<()> {
         let bad = |name: &str, v: Real, what: &str| {
-            Err(Error::Input(format!("fit parameter {name} = {v}: {what}")))
+            Err(Error::input(format!("fit parameter {name} = {v}: {what}")))
         };
         if !(self.tolerance_pct.is_finite()
             && self.tolerance_pct > 0.0

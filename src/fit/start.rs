@@ -49,7 +49,7 @@ impl FitRun {
     /// input and outputs are and the total time.
     pub fn report(&self, params: &FitParams) -> Result<Map<String, Value>> {
         let fit = serde_json::to_value(&self.result.report)
-            .map_err(|e| Error::Input(format!("the fit report cannot be serialised: {e}")))?;
+            .map_err(|e| Error::input(format!("the fit report cannot be serialised: {e}")))?;
         let mut map = Map::new();
         map.insert("init".into(), self.init_report.clone());
         map.insert("tolerance_pct".into(), json!(params.tolerance_pct));
@@ -162,7 +162,7 @@ pub fn fit_from_start(
 ) -> Result<FitRun> {
     params.check()?;
     if cloud.len() < MIN_FIT_POINTS {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "{} points; a fit needs at least {MIN_FIT_POINTS} points spread over the surface",
             cloud.len()
         )));

@@ -20,10 +20,12 @@ pub fn inflation_force(
     pressure: Real,
 ) -> Result<Vec<Point3>> {
     if !pressure.is_finite() {
-        return Err(Error::Input(format!("pressure {pressure} is not finite")));
+        return Err(Error::non_finite(format!(
+            "pressure {pressure} is not finite"
+        )));
     }
     if du.len() != weights.len() || dv.len() != weights.len() || j.num_rows() != weights.len() {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "inflation: {} rows, {} and {} tangents, {} weights",
             j.num_rows(),
             du.len(),

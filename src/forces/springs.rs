@@ -41,7 +41,7 @@ impl SpringSystem {
             self.matrix = self.matrix.linear_combination(1.0, &other.matrix, 1.0)?;
         }
         if self.rhs.len() != other.rhs.len() {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "springs over {} and {} control points",
                 self.rhs.len(),
                 other.rhs.len()
@@ -64,7 +64,7 @@ pub fn spring_system(
     k: &[Real],
 ) -> Result<SpringSystem> {
     if points.len() != closest.len() || points.len() != k.len() {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "springs: {} points, {} closest points, {} stiffnesses",
             points.len(),
             closest.len(),
@@ -72,7 +72,7 @@ pub fn spring_system(
         )));
     }
     if let Some(i) = k.iter().position(|&k| !(k >= 0.0 && k.is_finite())) {
-        return Err(Error::Input(format!("spring {i} has stiffness {}", k[i])));
+        return Err(Error::input(format!("spring {i} has stiffness {}", k[i])));
     }
     let table = engine.table();
     let s = table.to_level();
@@ -97,7 +97,7 @@ pub fn row_springs(
     k: &[Real],
 ) -> Result<SpringSystem> {
     if j.num_rows() != d.len() || x.len() != d.len() || k.len() != d.len() {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "springs: {} rows, {} surface points, {} targets, {} stiffnesses",
             j.num_rows(),
             x.len(),
@@ -145,7 +145,7 @@ pub fn spread_point_springs(
     radius: Real,
 ) -> Result<SpringSystem> {
     if points.len() != closest.len() || points.len() != k.len() || j.num_rows() != x.len() {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "spread springs: {} points, {} closest points, {} stiffnesses; {} rows, {} samples",
             points.len(),
             closest.len(),
@@ -155,7 +155,7 @@ pub fn spread_point_springs(
         )));
     }
     if !(radius > 0.0 && radius.is_finite()) || x.is_empty() {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "spread springs need samples and a positive radius (got {radius}, {} samples)",
             x.len()
         )));

@@ -149,20 +149,20 @@ pub fn check_writable(path: &Path) -> Result<()> {
         _ => Path::new("."),
     };
     if !dir.is_dir() {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "{}: the directory {} does not exist",
             path.display(),
             dir.display()
         )));
     }
     if path.is_dir() {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "{}: is a directory, not a file name to write to",
             path.display()
         )));
     }
     let (temp, file) = create_temp(path).map_err(|e| {
-        Error::Input(format!(
+        Error::input(format!(
             "{}: cannot create a file in {}: {e}",
             path.display(),
             dir.display()

@@ -47,7 +47,7 @@ impl OutputBatch {
     pub fn begin() -> Result<Self> {
         let mut reg = registry();
         if reg.staged.is_some() {
-            return Err(Error::Input("an output batch is already open".into()));
+            return Err(Error::input("an output batch is already open"));
         }
         reg.staged = Some(Vec::new());
         reg.created_dirs.clear();
@@ -138,7 +138,7 @@ pub fn check_output_dir_path(dir: &Path) -> Result<()> {
         .find(|a| a.exists())
         .unwrap_or(Path::new("."));
     if !existing.is_dir() {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "{}: {} is a file, not a directory for outputs",
             dir.display(),
             existing.display()

@@ -46,11 +46,11 @@ impl MeshFormat {
             Some("ply") => Ok(MeshFormat::Ply),
             Some("off") => Ok(MeshFormat::Off),
             Some("xyz") => Ok(MeshFormat::Xyz),
-            Some(other) => Err(Error::Input(format!(
+            Some(other) => Err(Error::unsupported(format!(
                 "{}: unknown file extension `.{other}`; supported: {SUPPORTED}",
                 path.display()
             ))),
-            None => Err(Error::Input(format!(
+            None => Err(Error::unsupported(format!(
                 "{}: no file extension to tell the format; supported: {SUPPORTED}",
                 path.display()
             ))),

@@ -131,7 +131,7 @@ pub fn lattice_from_json(bytes: &[u8], path: &Path) -> Result<Lattice> {
         .collect();
     let in_file = |e: Error| match e {
         Error::Topology(m) => Error::Topology(format!("{name}: {m}")),
-        Error::Input(m) => Error::Input(format!("{name}: {m}")),
+        Error::Input(m) => Error::with_kind(m.kind(), format!("{name}: {m}")),
         other => other,
     };
     let topo = match (&file.faces, &file.cells, &file.hexahedra, &file.polyhedra) {

@@ -21,7 +21,7 @@ const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
 pub(crate) fn open_regular(path: &Path) -> Result<File> {
     let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
     if !meta.is_file() {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "{}: not a regular file ({}); inputs must be files",
             path.display(),
             file_kind(&meta)

@@ -92,7 +92,7 @@ pub fn write_mesh_with_creases(
         .iter()
         .find(|&&(i, j, s)| i as usize >= n || j as usize >= n || i == j || s.is_nan() || s < 0.0)
     {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "crease {i} {j} {s} is not an edge sharpness of a mesh of {n} vertices"
         )));
     }
@@ -139,7 +139,7 @@ pub fn write_points(path: impl AsRef<Path>, cloud: &PointCloud) -> Result<()> {
     let path = path.as_ref();
     let format = MeshFormat::from_path(path)?;
     if let Some(i) = first_non_finite(&cloud.positions) {
-        return Err(Error::Input(format!(
+        return Err(Error::non_finite(format!(
             "point {i} has a non-finite coordinate ({}, {}, {})",
             cloud.positions[i].x, cloud.positions[i].y, cloud.positions[i].z
         )));
@@ -160,7 +160,7 @@ fn check_normals(normals: Option<&[Vector3]>, num_vertices: usize) -> Result<()>
         return Ok(());
     };
     if normals.len() != num_vertices {
-        return Err(Error::Input(format!(
+        return Err(Error::size_mismatch(format!(
             "{} normals for {num_vertices} vertices",
             normals.len()
         )));
@@ -169,7 +169,7 @@ fn check_normals(normals: Option<&[Vector3]>, num_vertices: usize) -> Result<()>
         .iter()
         .position(|n| !n.iter().all(|c| c.is_finite()))
     {
-        Some(i) => Err(Error::Input(format!("normal {i} is not finite"))),
+        Some(i) => Err(Error::non_finite(format!("normal {i} is not finite"))),
         None => Ok(()),
     }
 }

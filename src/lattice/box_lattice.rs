@@ -61,13 +61,13 @@ pub fn bounding_frame(
     margin: Real,
 ) -> Result<(Point3, [Vector3; 3])> {
     if points.is_empty() {
-        return Err(Error::Input("no vertices to build a lattice around".into()));
+        return Err(Error::input("no vertices to build a lattice around"));
     }
     if let Some(i) = points
         .iter()
         .position(|p| !p.coords.iter().all(|x| x.is_finite()))
     {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "vertex {i}: coordinate is not a finite number"
         )));
     }
@@ -161,13 +161,13 @@ impl BoxCells {
 /// The box, its `2^K` grid and the cells kept after culling and dilation.
 pub(super) fn box_cells(points: &[Point3], params: &BoxLatticeParams) -> Result<BoxCells> {
     if params.octree_levels > 7 {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "{} octree levels requested; at most 7 (128³ cells) are allowed",
             params.octree_levels
         )));
     }
     if !(params.margin.is_finite() && params.margin >= 0.0) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "margin {} must be a finite number ≥ 0",
             params.margin
         )));
@@ -185,7 +185,7 @@ pub(super) fn box_cells(points: &[Point3], params: &BoxLatticeParams) -> Result<
         for p in points {
             let t = cells
                 .grid_coords(p)
-                .ok_or_else(|| Error::Input("the bounding box is degenerate".into()))?;
+                .ok_or_else(|| Error::input("the bounding box is degenerate"))?;
             let ijk = [0, 1, 2].map(|k| (t[k].floor().max(0.0) as usize).min(n - 1));
             occupied[cells.cell_id(ijk[0], ijk[1], ijk[2])] = true;
         }

@@ -38,12 +38,12 @@ pub fn hexahedra(positions: Vec<Point3>, hexes: &[[u32; 8]]) -> Result<Lattice> 
 /// `(i, j, k)` has index `i + (nx + 1) (j + (ny + 1) k)`.
 pub fn box_grid(lo: Point3, hi: Point3, n: [usize; 3]) -> Result<Lattice> {
     if n.iter().any(|&k| k == 0 || k > 1024) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "box grid of {n:?} cells: each count must be 1 to 1024"
         )));
     }
     if (0..3).any(|k| (hi[k] - lo[k]).is_nan() || hi[k] - lo[k] <= 0.0) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "box grid: the corners {:?} and {:?} do not span a box",
             lo.coords.as_slice(),
             hi.coords.as_slice()
@@ -91,12 +91,12 @@ pub fn box_grid(lo: Point3, hi: Point3, n: [usize; 3]) -> Result<Lattice> {
 /// `v + l · mesh.num_vertices()`.
 pub fn extrude(mesh: &PolyMesh, direction: Vector3, layers: usize) -> Result<Lattice> {
     if layers == 0 || layers > 4096 {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "extrude: {layers} layers (expected 1 to 4096)"
         )));
     }
     if direction.norm().is_nan() || direction.norm() <= 0.0 || !direction.norm().is_finite() {
-        return Err(Error::Input("extrude: the direction has no length".into()));
+        return Err(Error::input("extrude: the direction has no length"));
     }
     let nv = mesh.num_vertices();
     let mut positions = Vec::with_capacity(nv * (layers + 1));
@@ -130,7 +130,7 @@ pub fn extrude(mesh: &PolyMesh, direction: Vector3, layers: usize) -> Result<Lat
 pub fn cylinder(radius: Real, height: Real, segments: usize, layers: usize) -> Result<Lattice> {
     let positive = |x: Real| x.is_finite() && x > 0.0;
     if !(3..=256).contains(&segments) || !positive(radius) || !positive(height) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "cylinder: radius {radius}, height {height}, {segments} segments (need positive sizes and 3 to 256 segments)"
         )));
     }
@@ -191,7 +191,9 @@ impl LatticeBuilder {
     /// face opposite `face`, onto which the next cell can be attached.
     pub fn attach_cell(&mut self, face: &[u32], offset: Vector3) -> Result<Vec<u32>> {
         if let Some(&v) = face.iter().find(|&&v| v as usize >= self.positions.len()) {
-            return Err(Error::Input(format!("attach: vertex {v} does not exist")));
+            return Err(Error::out_of_range(format!(
+                "attach: vertex {v} does not exist"
+            )));
         }
         let top: Vec<u32> = face
             .iter()

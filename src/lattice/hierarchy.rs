@@ -48,7 +48,7 @@ impl LatticeHierarchy {
         n: usize,
     ) -> Result<LatticeHierarchy> {
         if n > MAX_LATTICE_LEVELS {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "{n} lattice levels requested; at most {MAX_LATTICE_LEVELS} are allowed (cells grow eightfold per level)"
             )));
         }
@@ -60,9 +60,7 @@ impl LatticeHierarchy {
         }];
         let mut stencils = Vec::with_capacity(n);
         for _ in 0..n {
-            let last = levels
-                .last()
-                .ok_or_else(|| Error::Input("no level".into()))?;
+            let last = levels.last().ok_or_else(|| Error::input("no level"))?;
             let s = refinement_stencil(&last.topology, &last.tags);
             let (child, type_n) = refined_topology(&last.topology)?;
             let child_tags = refined_tags(&last.topology, &last.tags, &child);
@@ -89,7 +87,7 @@ impl LatticeHierarchy {
     /// The composed table `S_k = S_{k-1} ⋯ S_0` from level-0 control points to level `k`.
     pub fn stencil_to_level(&self, k: usize) -> Result<StencilTable> {
         if k > self.depth() {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "level {k} requested from a lattice refined {} times",
                 self.depth()
             )));

@@ -60,7 +60,7 @@ impl BoundaryTags {
     /// Checks the sizes against a topology.
     pub fn check(&self, topo: &LatticeTopology) -> Result<()> {
         if self.corners.len() != topo.num_vertices || self.sharp_edges.len() != topo.num_edges() {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "boundary tags for {} vertices and {} edges, but the lattice has {} and {}",
                 self.corners.len(),
                 self.sharp_edges.len(),
@@ -147,7 +147,7 @@ impl Lattice {
 /// oriented consistently.
 pub fn check_geometry(positions: &[Point3], topo: &LatticeTopology) -> Result<()> {
     if positions.len() != topo.num_vertices {
-        return Err(Error::Input(format!(
+        return Err(Error::size_mismatch(format!(
             "{} positions for a lattice of {} vertices",
             positions.len(),
             topo.num_vertices
@@ -157,7 +157,7 @@ pub fn check_geometry(positions: &[Point3], topo: &LatticeTopology) -> Result<()
         .iter()
         .position(|p| !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()))
     {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "vertex {v}: coordinate is not a finite number ({:?})",
             positions[v].coords.as_slice()
         )));

@@ -57,14 +57,14 @@ pub fn locally_refined(
     let mut refine = vec![false; nc];
     for &c in chosen {
         *refine.get_mut(c).ok_or_else(|| {
-            Error::Input(format!(
+            Error::out_of_range(format!(
                 "cell {c} does not exist (the lattice has {nc} cells)"
             ))
         })? = true;
     }
     let cells_r: Vec<usize> = (0..nc).filter(|&c| refine[c]).collect();
     if cells_r.is_empty() {
-        return Err(Error::Input("no cell chosen for local refinement".into()));
+        return Err(Error::input("no cell chosen for local refinement"));
     }
     let mut positions = lattice.positions.clone();
     // Edge, face and cell points of the chosen cells.

@@ -49,7 +49,7 @@ pub fn shrunk_box_lattice(
     offset: Real,
 ) -> Result<(Lattice, ShrinkReport)> {
     if !(offset.is_finite() && offset >= 0.0) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "shrink offset {offset} must be a finite number ≥ 0"
         )));
     }
@@ -61,7 +61,7 @@ pub fn shrunk_box_lattice(
         .iter()
         .map(|p| cells.grid_coords(p))
         .collect::<Option<_>>()
-        .ok_or_else(|| Error::Input("the bounding box is degenerate".into()))?;
+        .ok_or_else(|| Error::input("the bounding box is degenerate"))?;
     // Model vertices by grid cell (clamped into the grid).
     let by_cell = Csr::from_pairs(
         n * n * n,

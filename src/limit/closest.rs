@@ -108,31 +108,31 @@ impl ClosestPointEngine {
         shapes: QuadtreeCache,
     ) -> Result<Self> {
         if params.level == 0 || params.level > 6 {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "closest-point level {} must be between 1 and 6",
                 params.level
             )));
         }
         if !(params.tolerance > 0.0 && params.tolerance < 1.0) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "closest-point tolerance {} must be in (0, 1)",
                 params.tolerance
             )));
         }
         if params.seeds_per_side == 0 || params.candidates == 0 || params.max_iterations == 0 {
-            return Err(Error::Input(
-                "closest-point seeds, candidates and iterations must be positive".into(),
+            return Err(Error::input(
+                "closest-point seeds, candidates and iterations must be positive",
             ));
         }
         if positions.len() != refiner.level.num_vertices {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "{} positions for a mesh of {} vertices",
                 positions.len(),
                 refiner.level.num_vertices
             )));
         }
         if refiner.level.num_faces() == 0 {
-            return Err(Error::Input("the control mesh has no faces".into()));
+            return Err(Error::input("the control mesh has no faces"));
         }
         let n = params.seeds_per_side;
         let table = PatchTable::with_quadtrees(refiner, positions, params.level, shapes)?;
@@ -260,7 +260,7 @@ impl ClosestPointEngine {
                 best = Some((d, f, st, e, settled));
             }
         }
-        let (d, f, st, e, settled) = best.ok_or_else(|| Error::Input("no seed found".into()))?;
+        let (d, f, st, e, settled) = best.ok_or_else(|| Error::input("no seed found"))?;
         // Orientation of (s, t) relative to (u, v) decides the normal's sign.
         let normal = (e.d[0].cross(&e.d[1]) * self.table.orientation(f))
             .try_normalize(0.0)
@@ -310,7 +310,7 @@ impl ClosestPointEngine {
         query: impl Fn(Point3, (u32, [Real; 2])) -> Result<ClosestPoint> + Sync,
     ) -> Result<Vec<ClosestPoint>> {
         if starts.len() != queries.len() {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "{} starting points for {} queries",
                 starts.len(),
                 queries.len()
@@ -532,7 +532,7 @@ fn check_query(q: Point3) -> Result<()> {
     if q.coords.iter().all(|c| c.is_finite()) {
         Ok(())
     } else {
-        Err(Error::Input(format!(
+        Err(Error::non_finite(format!(
             "query point ({}, {}, {}) is not finite",
             q.x, q.y, q.z
         )))

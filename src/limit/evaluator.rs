@@ -85,7 +85,7 @@ pub const MAX_EXACT_RING: usize = 256;
 fn check_face_rings(level: &Level, face: usize) -> Result<()> {
     let fv = level.face_vertices(face);
     if fv.len() > MAX_EXACT_RING {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "face {face} has {} vertices; exact limit evaluation takes faces of at most {MAX_EXACT_RING} (subdivide it first, or use subdivide --limit)",
             fv.len()
         )));
@@ -94,7 +94,7 @@ fn check_face_rings(level: &Level, face: usize) -> Result<()> {
         .iter()
         .find(|&&v| level.valence(v as usize) > MAX_EXACT_RING)
     {
-        Some(&v) => Err(Error::Input(format!(
+        Some(&v) => Err(Error::input(format!(
             "vertex {v} has valence {}; exact limit evaluation takes vertices of valence at most {MAX_EXACT_RING} (use subdivide --limit)",
             level.valence(v as usize)
         ))),
@@ -155,7 +155,7 @@ impl LimitEvaluator {
     /// and `d = ⌈√n⌉`, as in OpenSubdiv's `Bfr`.
     pub fn stencil(&self, face: usize, u: Real, v: Real) -> Result<SampleStencil> {
         if face >= self.num_faces() {
-            return Err(Error::Input(format!(
+            return Err(Error::out_of_range(format!(
                 "face {face} out of range: the mesh has {} faces",
                 self.num_faces()
             )));
@@ -171,7 +171,7 @@ impl LimitEvaluator {
             && (0.0..=umax).contains(&u)
             && (0.0..=umax).contains(&v))
         {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "parameter ({u}, {v}) of face {face} outside [0, {umax}]²"
             )));
         }
@@ -188,7 +188,7 @@ impl LimitEvaluator {
         positions: &[Point3],
     ) -> Result<LimitPoint> {
         if positions.len() != self.num_control_points() {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "{} control points given for a mesh of {}",
                 positions.len(),
                 self.num_control_points()

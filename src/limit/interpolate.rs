@@ -31,7 +31,7 @@ pub fn interpolate_limit_points(
     iterations: usize,
 ) -> Result<(Vec<Point3>, Real)> {
     if targets.len() != mesh.num_vertices() || movable.len() != mesh.num_vertices() {
-        return Err(Error::Input(format!(
+        return Err(Error::size_mismatch(format!(
             "{} limit targets and {} movable flags for {} control points",
             targets.len(),
             movable.len(),

@@ -67,7 +67,7 @@ pub fn tessellate(
     let plan = Tessellation::new(refiner, k)?;
     let level = &refiner.level;
     if positions.len() != level.num_vertices {
-        return Err(Error::Input(format!(
+        return Err(Error::size_mismatch(format!(
             "{} positions for a mesh of {} vertices",
             positions.len(),
             level.num_vertices
@@ -94,7 +94,7 @@ impl Tessellation {
     /// The tessellation of `refiner`'s mesh, `k × k` per quad (tile).
     pub fn new(refiner: &Refiner, k: usize) -> Result<Self> {
         if k == 0 || k > 1024 {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "tessellation rate {k} must be between 1 and 1024"
             )));
         }

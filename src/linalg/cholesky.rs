@@ -46,7 +46,7 @@ impl Pattern {
     fn new(a: &StencilTable) -> Result<Pattern> {
         let n = a.num_rows();
         if a.num_cols != n {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "Cholesky: the matrix is {n} × {}, not square",
                 a.num_cols
             )));
@@ -139,7 +139,7 @@ impl Pattern {
                 next[i] += 1;
             }
             if !(d > 0.0 && d.is_finite()) {
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "Cholesky: pivot {d:e} at control point {}: the matrix is not positive definite",
                     self.perm[k]
                 )));
@@ -189,7 +189,7 @@ impl SparseCholesky {
         let s = &self.pattern;
         let n = s.perm.len();
         if b.len() != n {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "Cholesky: {} right-hand sides for {n} unknowns",
                 b.len()
             )));

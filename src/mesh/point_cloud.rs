@@ -27,7 +27,7 @@ impl PointCloud {
         if let Some(n) = &normals
             && n.len() != positions.len()
         {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "{} normals for {} points",
                 n.len(),
                 positions.len()

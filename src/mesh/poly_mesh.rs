@@ -77,9 +77,7 @@ impl PolyMesh {
         if self.face_offsets.first().copied().unwrap_or(0) != 0
             || self.face_offsets.last().copied().unwrap_or(0) as usize != self.face_vertices.len()
         {
-            return Err(Error::Input(
-                "face offsets do not match face vertices".into(),
-            ));
+            return Err(Error::input("face offsets do not match face vertices"));
         }
         let n = self.positions.len();
         for (f, face) in self.faces().enumerate() {
@@ -102,7 +100,7 @@ impl PolyMesh {
 /// Checks that every coordinate is finite; the error names the first bad vertex.
 pub(crate) fn check_finite(points: &[Point3]) -> Result<()> {
     match first_non_finite(points) {
-        Some(i) => Err(Error::Input(format!(
+        Some(i) => Err(Error::non_finite(format!(
             "vertex {i} has a non-finite coordinate ({}, {}, {})",
             points[i].x, points[i].y, points[i].z
         ))),

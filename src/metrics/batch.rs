@@ -39,14 +39,14 @@ pub fn distances(bvh: &TriangleBvh, queries: &[Point3]) -> Result<Vec<Nearest>> 
         .position_first(|q| !q.coords.iter().all(|c| c.is_finite()))
     {
         let q = queries[i];
-        return Err(Error::Input(format!(
+        return Err(Error::non_finite(format!(
             "query point {i} has a non-finite coordinate ({}, {}, {})",
             q.x, q.y, q.z
         )));
     }
     let nearest = |q: &Point3| {
         bvh.closest_point(*q)
-            .ok_or_else(|| Error::Input("query point is not finite".into()))
+            .ok_or_else(|| Error::non_finite("query point is not finite"))
     };
     if queries.len() < SORT_FROM || queries.len() > u32::MAX as usize {
         return queries.par_iter().map(nearest).collect();
@@ -62,7 +62,7 @@ pub fn distances(bvh: &TriangleBvh, queries: &[Point3]) -> Result<Vec<Nearest>> 
             chunk.iter().map(move |q| {
                 let (found, slot) = bvh
                     .closest_point_from(*q, hint)
-                    .ok_or_else(|| Error::Input("query point is not finite".into()))?;
+                    .ok_or_else(|| Error::non_finite("query point is not finite"))?;
                 hint = Some(slot);
                 Ok(found)
             })

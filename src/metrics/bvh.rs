@@ -84,7 +84,7 @@ impl TriangleBvh {
     pub fn from_mesh(mesh: &PolyMesh) -> Result<Self> {
         mesh.validate()?;
         if mesh.num_faces() == 0 {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "the mesh has {} vertices but no faces; distances need triangles",
                 mesh.num_vertices()
             )));
@@ -114,7 +114,7 @@ impl TriangleBvh {
         faces: Vec<u32>,
     ) -> Result<Self> {
         if triangles.is_empty() {
-            return Err(Error::Input("no triangles to build a BVH over".into()));
+            return Err(Error::input("no triangles to build a BVH over"));
         }
         check_triangles(&positions, &triangles)?;
         let corners = |tri: &[u32; 3]| tri.map(|v| positions[v as usize]);

@@ -161,12 +161,12 @@ pub fn compare_points(
 ) -> Result<Comparison> {
     let diagonal = reference_diagonal(b)?;
     if points.is_empty() {
-        return Err(Error::Input("no points to compare".into()));
+        return Err(Error::input("no points to compare"));
     }
     if let Some(n) = normals
         && n.len() != points.len()
     {
-        return Err(Error::Input(format!(
+        return Err(Error::size_mismatch(format!(
             "{} normals for {} points",
             n.len(),
             points.len()
@@ -191,7 +191,7 @@ fn reference_diagonal(b: &Surface) -> Result<Real> {
     if d > 0.0 && d.is_finite() {
         Ok(d)
     } else {
-        Err(Error::Input(format!(
+        Err(Error::input(format!(
             "the reference surface has bounding-box diagonal {d}; percentages need a positive one"
         )))
     }

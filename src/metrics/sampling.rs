@@ -43,7 +43,7 @@ pub fn area_samples(
         .iter()
         .position(|tri| tri.iter().any(|&v| v as usize >= np))
     {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "triangle {t} refers to a vertex beyond the {np} positions"
         )));
     }
@@ -57,7 +57,7 @@ pub fn area_samples(
         .collect();
     let total: Real = areas.iter().sum();
     if !(total > 0.0 && total.is_finite()) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "cannot sample {n} points: the {} triangles have total area {total}",
             triangles.len()
         )));

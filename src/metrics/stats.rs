@@ -46,10 +46,10 @@ impl DistanceStats {
     /// negative or not finite (naming the first).
     pub fn new(distances: &[Real]) -> Result<Self> {
         if distances.is_empty() {
-            return Err(Error::Input("no distances to summarise".into()));
+            return Err(Error::input("no distances to summarise"));
         }
         if let Some(i) = distances.iter().position(|d| !(d.is_finite() && *d >= 0.0)) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "distance {i} is {}: distances must be finite and non-negative",
                 distances[i]
             )));

@@ -227,7 +227,7 @@ pub fn triangle_normal(a: Point3, b: Point3, c: Point3) -> Vector3 {
 /// in range.
 pub(crate) fn check_triangles(positions: &[Point3], triangles: &[[u32; 3]]) -> Result<()> {
     if triangles.len() > u32::MAX as usize {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "{} triangles: at most {} are supported",
             triangles.len(),
             u32::MAX
@@ -240,7 +240,7 @@ pub(crate) fn check_triangles(positions: &[Point3], triangles: &[[u32; 3]]) -> R
         .enumerate()
         .find(|(_, tri)| tri.iter().any(|&v| v as usize >= n))
     {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "triangle {t} refers to vertex {}, but there are only {n} vertices",
             tri.iter().copied().max().unwrap_or(0)
         )));

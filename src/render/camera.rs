@@ -60,7 +60,7 @@ impl Camera {
         projection: Projection,
     ) -> Result<Camera> {
         if !azimuth.is_finite() || !elevation.is_finite() || elevation.abs() > 90.0 {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "view azimuth {azimuth}, elevation {elevation}: the azimuth must be finite and the elevation between -90 and 90 degrees"
             )));
         }
@@ -74,7 +74,7 @@ impl Camera {
             Projection::Orthographic => (2.0 * radius, None),
             Projection::Perspective { fov_deg } => {
                 if !(fov_deg.is_finite() && fov_deg > 0.0 && fov_deg <= 170.0) {
-                    return Err(Error::Input(format!(
+                    return Err(Error::out_of_range(format!(
                         "field of view {fov_deg} degrees is out of range: expected (0, 170]"
                     )));
                 }

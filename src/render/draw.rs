@@ -53,9 +53,8 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Picture> {
         .chain(scene.clouds.iter().flat_map(|c| c.cloud.positions.iter()))
         .copied()
         .collect();
-    let (lo, hi) = bounding_box(&points).ok_or_else(|| {
-        Error::Input("nothing to draw: the scene has no vertices or points".into())
-    })?;
+    let (lo, hi) = bounding_box(&points)
+        .ok_or_else(|| Error::input("nothing to draw: the scene has no vertices or points"))?;
     let diag = bbox_diagonal(&points);
 
     let (w, h) = (options.width, options.height);

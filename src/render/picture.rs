@@ -46,7 +46,7 @@ impl Picture {
     pub fn from_pixels(width: u32, height: u32, pixels: Vec<Rgb>) -> Result<Picture> {
         check_size(width, height)?;
         if pixels.len() != width as usize * height as usize {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "{} pixels for a {width}×{height} picture",
                 pixels.len()
             )));
@@ -121,7 +121,7 @@ impl Picture {
     pub fn to_png(&self) -> Result<Vec<u8>> {
         let mut bytes = Vec::new();
         self.encode_png(&mut bytes)
-            .map_err(|e| Error::Input(format!("cannot encode the PNG: {e}")))?;
+            .map_err(|e| Error::input(format!("cannot encode the PNG: {e}")))?;
         Ok(bytes)
     }
 
@@ -166,7 +166,7 @@ pub fn check_png_path(path: &Path) -> Result<()> {
     if is_png {
         crate::io::check_writable(path)
     } else {
-        Err(Error::Input(format!(
+        Err(Error::input(format!(
             "{}: pictures are written as PNG; the file name must end in .png",
             path.display()
         )))
@@ -176,7 +176,7 @@ pub fn check_png_path(path: &Path) -> Result<()> {
 /// Fails unless both sides are 1 to [`MAX_SIDE`].
 pub(crate) fn check_size(width: u32, height: u32) -> Result<()> {
     if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
-        return Err(Error::Input(format!(
+        return Err(Error::out_of_range(format!(
             "picture size {width}×{height} is out of range: each side must be 1 to {MAX_SIDE} pixels"
         )));
     }

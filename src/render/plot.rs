@@ -76,12 +76,12 @@ pub fn line_plot(series: &[Series], options: &PlotOptions) -> Result<Picture> {
         .flat_map(|s| s.points.iter().copied())
         .collect();
     if pts.is_empty() {
-        return Err(Error::Input("nothing to plot".into()));
+        return Err(Error::input("nothing to plot"));
     }
     let bad = |x: Real, y: Real| !x.is_finite() || !y.is_finite() || (log_y && y <= 0.0);
     if pts.iter().any(|p| bad(p.0, p.1)) || options.hlines.iter().any(|h| bad(0.0, h.y)) {
-        return Err(Error::Input(
-            "plot values must be finite (and positive on a log axis)".into(),
+        return Err(Error::input(
+            "plot values must be finite (and positive on a log axis)",
         ));
     }
     let fy = |y: Real| if log_y { y.log10() } else { y };
@@ -112,7 +112,7 @@ pub fn line_plot(series: &[Series], options: &PlotOptions) -> Result<Picture> {
     };
     let (left, right, bottom) = (70i64, width as i64 - 150, height as i64 - 45);
     if right - left < 50 || bottom - top < 50 {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "plot size {width}×{height} is too small"
         )));
     }

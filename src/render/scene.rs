@@ -237,7 +237,7 @@ impl RenderOptions {
     pub fn validate(&self) -> Result<()> {
         super::picture::check_size(self.width, self.height)?;
         if !(1..=4).contains(&self.supersample) {
-            return Err(Error::Input(format!(
+            return Err(Error::out_of_range(format!(
                 "supersampling factor {} is out of range: expected 1 to 4",
                 self.supersample
             )));
@@ -245,13 +245,13 @@ impl RenderOptions {
         let k = u64::from(self.supersample);
         let work = u64::from(self.width) * u64::from(self.height) * k * k;
         if work > MAX_WORK_PIXELS {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "{}×{} with {k}× supersampling needs {work} working pixels; at most {MAX_WORK_PIXELS} are allowed",
                 self.width, self.height
             )));
         }
         if !(0.0..0.5).contains(&self.margin) {
-            return Err(Error::Input(format!(
+            return Err(Error::out_of_range(format!(
                 "margin {} is out of range: expected 0 to 0.5",
                 self.margin
             )));
@@ -259,7 +259,7 @@ impl RenderOptions {
         if let Some((lo, hi)) = self.scalar_range
             && !(lo.is_finite() && hi.is_finite() && lo <= hi)
         {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "scalar range {lo}..{hi}: expected two finite numbers, the first not above the second"
             )));
         }
@@ -279,7 +279,7 @@ pub(crate) fn validate_scene(scene: &Scene) -> Result<()> {
             .iter()
             .find(|&&(a, b)| a as usize >= n || b as usize >= n)
         {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "mesh {i}: sharp edge {a} {b} names a vertex beyond its {n}"
             )));
         }
@@ -300,7 +300,7 @@ pub(crate) fn validate_scene(scene: &Scene) -> Result<()> {
             c.cloud.len(),
         )?;
         if !(c.radius.is_finite() && (0.0..=100.0).contains(&c.radius)) {
-            return Err(Error::Input(format!(
+            return Err(Error::out_of_range(format!(
                 "point radius {} pixels is out of range: expected 0 to 100",
                 c.radius
             )));
@@ -312,7 +312,7 @@ pub(crate) fn validate_scene(scene: &Scene) -> Result<()> {
 /// `Err` when an optional per-vertex array has the wrong length.
 fn check_len(kind: &str, i: usize, what: &str, len: Option<usize>, n: usize) -> Result<()> {
     match len {
-        Some(len) if len != n => Err(Error::Input(format!(
+        Some(len) if len != n => Err(Error::size_mismatch(format!(
             "{kind} layer {i}: {len} {what} for {n} vertices"
         ))),
         _ => Ok(()),

@@ -34,7 +34,7 @@ pub fn slice_overlay(
 ) -> Result<Picture> {
     let dims = volume.dims();
     if axis > 2 {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "slice axis {axis} is not 0 (sagittal), 1 (coronal) or 2 (axial)"
         )));
     }
@@ -56,7 +56,7 @@ pub fn slice_overlay(
         }
     }
     if !(at >= lo[axis] && at <= hi[axis]) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "slice {}{at} is outside the volume ({} to {})",
             ["x = ", "y = ", "z = "][axis],
             lo[axis],

@@ -25,7 +25,7 @@ pub fn extruded_topology(
     face: usize,
 ) -> Result<(LatticeTopology, Vec<u32>)> {
     if face >= topo.num_faces() || !topo.is_boundary_face(face) {
-        return Err(Error::Input(format!(
+        return Err(Error::out_of_range(format!(
             "extrude: face {face} is not a boundary face of the control lattice ({} faces)",
             topo.num_faces()
         )));
@@ -103,13 +103,13 @@ pub fn trimmed_topology(
     cell: usize,
 ) -> Result<(LatticeTopology, Vec<Option<u32>>)> {
     if cell >= topo.num_cells() {
-        return Err(Error::Input(format!(
+        return Err(Error::out_of_range(format!(
             "trim: cell {cell} does not exist ({} cells)",
             topo.num_cells()
         )));
     }
     if topo.num_cells() == 1 {
-        return Err(Error::Input("trim: cannot remove the only cell".into()));
+        return Err(Error::input("trim: cannot remove the only cell"));
     }
     let keep_cells: Vec<usize> = (0..topo.num_cells()).filter(|&c| c != cell).collect();
     let mut face_map = vec![None; topo.num_faces()];

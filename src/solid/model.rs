@@ -108,7 +108,7 @@ pub fn lumped_masses(topo: &LatticeTopology, rest: &[Point3], density: Real) -> 
         }
     }
     if let Some(i) = m.iter().position(|&x| !(x > 0.0 && x.is_finite())) {
-        return Err(Error::Input(format!("mass point {i} has mass {}", m[i])));
+        return Err(Error::input(format!("mass point {i} has mass {}", m[i])));
     }
     Ok(m)
 }
@@ -159,7 +159,7 @@ impl Solid {
         self.fine = levels
             .pop()
             .map(|l| l.topology)
-            .ok_or_else(|| Error::Input("empty lattice hierarchy".into()))?;
+            .ok_or_else(|| Error::input("empty lattice hierarchy"))?;
         let rest = self.a.apply(&self.p_rest)?;
         self.springs = SpringNetwork::new(&self.fine, &rest)?;
         self.mass = lumped_masses(&self.fine, &rest, self.params.density)?;

@@ -94,7 +94,7 @@ impl Default for SolidParams {
 pub fn check_value(name: &str, x: Real, positive: bool) -> Result<()> {
     let ok = x.is_finite() && if positive { x > 0.0 } else { x >= 0.0 };
     if !ok || x > 1e12 {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "{name} = {x}: expected a finite {} number up to 1e12",
             if positive { "positive" } else { "non-negative" }
         )));
@@ -108,7 +108,7 @@ impl SolidParams {
     /// CG iterations, a preconditioner refresh threshold of at least 1.
     pub fn check(&self) -> Result<()> {
         if self.level > MAX_SOLID_LEVEL {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "level {} is too fine for a solid (at most {MAX_SOLID_LEVEL})",
                 self.level
             )));
@@ -118,18 +118,18 @@ impl SolidParams {
         check_value("virtual spring stiffness", self.stiffness.virtual_, false)?;
         check_value("damping", self.damping, false)?;
         if !(self.cg_tolerance > 0.0 && self.cg_tolerance < 1.0) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "CG tolerance {} must lie in (0, 1)",
                 self.cg_tolerance
             )));
         }
         if self.preconditioner_refresh == 0 {
-            return Err(Error::Input(
-                "preconditioner refresh after 0 extra CG iterations: expected at least 1".into(),
+            return Err(Error::input(
+                "preconditioner refresh after 0 extra CG iterations: expected at least 1",
             ));
         }
         if self.cg_max_iterations == 0 || self.cg_max_iterations > 100_000 {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "{} CG iterations: expected 1 to 100,000",
                 self.cg_max_iterations
             )));

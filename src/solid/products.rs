@@ -30,7 +30,7 @@ pub fn cholesky(t: &StencilTable, what: &str) -> Result<Cholesky<Real, Dyn>> {
 pub fn cholesky_dense(m: DMatrix<Real>, what: &str) -> Result<Cholesky<Real, Dyn>> {
     let n = m.nrows();
     Cholesky::new(m)
-        .ok_or_else(|| Error::Input(format!("the {what} ({n}×{n}) is not positive definite")))
+        .ok_or_else(|| Error::input(format!("the {what} ({n}×{n}) is not positive definite")))
 }
 
 /// Solves `P z = r` coordinate by coordinate with a factored scalar `P`.

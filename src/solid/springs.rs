@@ -156,7 +156,7 @@ impl SpringNetwork {
     /// length (coincident mass points) or the sizes disagree.
     pub fn new(topo: &LatticeTopology, rest: &[Point3]) -> Result<SpringNetwork> {
         if rest.len() != topo.num_vertices {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "spring network: {} rest positions for {} mass points",
                 rest.len(),
                 topo.num_vertices
@@ -200,7 +200,7 @@ impl SpringNetwork {
     /// scales (stiffnesses) are unchanged. Errors on a zero length.
     pub fn set_rest(&mut self, x: &[Point3]) -> Result<()> {
         if x.len() != self.num_points {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "spring network: {} positions for {} mass points",
                 x.len(),
                 self.num_points
@@ -214,7 +214,7 @@ impl SpringNetwork {
             .collect();
         if let Some(i) = edge_rest.iter().position(|&l| !(l > 0.0 && l.is_finite())) {
             let [a, b] = self.edges[i];
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "spring between mass points {a} and {b} has length {} (coincident points)",
                 edge_rest[i]
             )));
@@ -224,7 +224,7 @@ impl SpringNetwork {
             .position(|&l| !(l > 0.0 && l.is_finite()))
         {
             let [m, a, b] = self.virtuals[i];
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "virtual spring of mass point {m} (neighbours {a}, {b}) has length {} (a flat face corner)",
                 virtual_rest[i]
             )));

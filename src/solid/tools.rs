@@ -77,7 +77,7 @@ impl Solid {
         rest_length: Real,
     ) -> Result<usize> {
         if point >= self.d.len() {
-            return Err(Error::Input(format!(
+            return Err(Error::out_of_range(format!(
                 "rope: mass point {point} does not exist ({} mass points)",
                 self.d.len()
             )));
@@ -98,10 +98,9 @@ impl Solid {
     pub fn set_rope_target(&mut self, rope: usize, target: Point3) -> Result<()> {
         check_target(&target)?;
         let n = self.ropes.len();
-        let r = self
-            .ropes
-            .get_mut(rope)
-            .ok_or_else(|| Error::Input(format!("rope {rope} does not exist ({n} ropes)")))?;
+        let r = self.ropes.get_mut(rope).ok_or_else(|| {
+            Error::out_of_range(format!("rope {rope} does not exist ({n} ropes)"))
+        })?;
         r.target = target;
         Ok(())
     }
@@ -120,7 +119,7 @@ impl Solid {
     /// (on error the fixed set is left unchanged). Fixed points stop.
     pub fn set_fixed(&mut self, points: &[usize], fixed: bool) -> Result<()> {
         if let Some(&i) = points.iter().find(|&&i| i >= self.p.len()) {
-            return Err(Error::Input(format!(
+            return Err(Error::out_of_range(format!(
                 "control point {i} does not exist ({} control points)",
                 self.p.len()
             )));
@@ -166,7 +165,7 @@ impl Solid {
     /// rest shape is unchanged and fixed points keep zero velocity.
     pub fn set_state(&mut self, p: &[Point3], v: &[Vector3]) -> Result<()> {
         if p.len() != self.p.len() || v.len() != self.p.len() {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "state of {} positions and {} velocities for {} control points",
                 p.len(),
                 v.len(),
@@ -176,7 +175,7 @@ impl Solid {
         if p.iter().any(|x| !x.coords.iter().all(|c| c.is_finite()))
             || v.iter().any(|x| !x.iter().all(|c| c.is_finite()))
         {
-            return Err(Error::Input("state: a coordinate is not finite".into()));
+            return Err(Error::non_finite("state: a coordinate is not finite"));
         }
         self.p = p.to_vec();
         self.v = v
@@ -199,7 +198,7 @@ fn check_target(t: &Point3) -> Result<()> {
     if t.coords.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
-        Err(Error::Input(format!(
+        Err(Error::non_finite(format!(
             "rope target {:?} is not finite",
             t.coords.as_slice()
         )))

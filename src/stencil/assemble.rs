@@ -33,7 +33,7 @@ impl Elements {
     /// the global indices `cols`.
     pub fn push(&mut self, cols: &[u32], matrix: &[Real]) -> Result<()> {
         if matrix.len() != cols.len() * cols.len() {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "an element over {} columns has {} entries",
                 cols.len(),
                 matrix.len()
@@ -72,7 +72,7 @@ impl StencilTable {
     /// size `m_e`.
     pub fn from_elements(n: usize, elements: &Elements) -> Result<StencilTable> {
         if let Some(&c) = elements.cols.iter().find(|&&c| c as usize >= n) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "an element refers to column {c} of a {n}-column matrix"
             )));
         }

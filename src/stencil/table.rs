@@ -195,7 +195,7 @@ impl StencilTable {
 
     fn check_transpose_input(&self, n: usize) -> Result<()> {
         if n != self.num_rows() {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "stencil table has {} rows but {n} values were given",
                 self.num_rows()
             )));
@@ -224,7 +224,7 @@ impl StencilTable {
     /// Weights smaller than `1e-300` in magnitude after summation are dropped.
     pub fn compose(&self, inner: &StencilTable) -> Result<StencilTable> {
         if self.num_cols != inner.num_rows() {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "cannot compose: outer table has {} columns, inner has {} rows",
                 self.num_cols,
                 inner.num_rows()
@@ -281,7 +281,7 @@ impl StencilTable {
 
     fn check_input(&self, n: usize) -> Result<()> {
         if n != self.num_cols {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "stencil table expects {} control points, got {n}",
                 self.num_cols
             )));
@@ -417,7 +417,7 @@ impl StencilTable {
     /// Every row `r` multiplied by `s[r]`.
     pub fn scale_rows(&self, s: &[Real]) -> Result<StencilTable> {
         if s.len() != self.num_rows() {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "{} row scales for a table of {} rows",
                 s.len(),
                 self.num_rows()
@@ -436,7 +436,7 @@ impl StencilTable {
     pub fn stack(tables: &[&StencilTable]) -> Result<StencilTable> {
         let cols = tables.first().map_or(0, |t| t.num_cols);
         if let Some(t) = tables.iter().find(|t| t.num_cols != cols) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "cannot stack tables of {} and {} columns",
                 cols, t.num_cols
             )));
@@ -485,7 +485,7 @@ impl StencilTable {
         b: Real,
     ) -> Result<StencilTable> {
         if self.num_cols != other.num_cols || self.num_rows() != other.num_rows() {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "cannot add a {}×{} table to a {}×{} table",
                 other.num_rows(),
                 other.num_cols,

@@ -62,7 +62,7 @@ impl CurveTopology {
     pub fn new(scheme: CurveScheme, num_points: usize, closed: bool) -> Result<Self> {
         let need = if closed { 3 } else { scheme.degree() + 1 };
         if num_points < need || num_points > MAX_POINTS {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "{} {} curve needs {need} to {MAX_POINTS} control points, got {num_points}",
                 if closed { "a closed" } else { "an open" },
                 format!("{scheme:?}").to_lowercase()
@@ -150,7 +150,7 @@ impl CurveTopology {
     pub fn locate(&self, t: Real) -> Result<(usize, Real)> {
         let spans = self.num_spans() as Real;
         if !t.is_finite() || (!self.closed && !(0.0..=spans).contains(&t)) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "curve parameter {t} is outside [0, {spans}]"
             )));
         }

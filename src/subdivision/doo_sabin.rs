@@ -151,7 +151,7 @@ impl DooSabinHierarchy {
 /// ```
 pub fn doo_sabin_refine(mesh: &PolyMesh, levels: usize) -> Result<DooSabinHierarchy> {
     if levels > 8 {
-        return Err(crate::Error::Input(format!(
+        return Err(crate::Error::input(format!(
             "{levels} Doo-Sabin levels requested; at most 8 are allowed"
         )));
     }
@@ -162,7 +162,7 @@ pub fn doo_sabin_refine(mesh: &PolyMesh, levels: usize) -> Result<DooSabinHierar
     for _ in 0..levels {
         let parent = h.finest();
         if parent.face_vertices.len() > 50_000_000 {
-            return Err(crate::Error::Input(format!(
+            return Err(crate::Error::input(format!(
                 "a further Doo-Sabin level of a mesh with {} face corners would be too large",
                 parent.face_vertices.len()
             )));

@@ -100,7 +100,7 @@ pub fn refine_marked(
 ) -> Result<LocalRefinement> {
     let (nf, ne, nv) = (level.num_faces(), level.num_edges(), level.num_vertices);
     if marked.len() != nf || uniform.num_rows() != nf + ne + nv {
-        return Err(Error::Input(format!(
+        return Err(Error::size_mismatch(format!(
             "local refinement: {} marks and {} stencil rows for {nf} faces, {ne} edges, {nv} vertices",
             marked.len(),
             uniform.num_rows()

@@ -52,14 +52,14 @@ fn ratio(num: Real, den: Real, fallback: Real) -> Real {
 /// Checks that there is one finite, non-negative interval per edge.
 pub fn check_intervals(level: &Level, d: &[Real]) -> Result<()> {
     if d.len() != level.num_edges() {
-        return Err(Error::Input(format!(
+        return Err(Error::size_mismatch(format!(
             "{} knot intervals given for a mesh with {} edges",
             d.len(),
             level.num_edges()
         )));
     }
     if let Some(e) = d.iter().position(|x| !x.is_finite() || *x < 0.0) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "knot interval of edge {e} is {}; intervals must be finite and ≥ 0",
             d[e]
         )));
@@ -278,7 +278,7 @@ impl NonUniformHierarchy {
     /// ```
     pub fn new(level: Level, d: Vec<Real>, levels: usize) -> Result<Self> {
         if levels > 8 {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "{levels} non-uniform levels requested; at most 8 are allowed"
             )));
         }
@@ -300,7 +300,7 @@ impl NonUniformHierarchy {
     /// The composed table from level 0 to level `n`.
     pub fn stencil_to_level(&self, n: usize) -> Result<StencilTable> {
         if n >= self.levels.len() {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "level {n} requested but the hierarchy has {} levels",
                 self.levels.len() - 1
             )));

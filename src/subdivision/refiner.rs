@@ -45,7 +45,7 @@ impl FromStr for TriangleRule {
         match s {
             "catmark" => Ok(TriangleRule::Catmark),
             "smooth" => Ok(TriangleRule::Smooth),
-            _ => Err(Error::Input(format!(
+            _ => Err(Error::input(format!(
                 "unknown triangle rule '{s}': expected catmark or smooth"
             ))),
         }
@@ -70,7 +70,7 @@ impl FromStr for BoundaryRule {
             "edge-and-corner" => Ok(BoundaryRule::EdgeAndCorner),
             "edge-only" => Ok(BoundaryRule::EdgeOnly),
             "none" => Ok(BoundaryRule::None),
-            _ => Err(Error::Input(format!(
+            _ => Err(Error::input(format!(
                 "unknown boundary rule '{s}': expected edge-and-corner, edge-only or none"
             ))),
         }
@@ -150,7 +150,7 @@ impl Refiner {
         let mut holes = vec![false; level.num_faces()];
         for (k, &f) in options.holes.iter().enumerate() {
             *holes.get_mut(f as usize).ok_or_else(|| {
-                Error::Input(format!(
+                Error::out_of_range(format!(
                     "hole {k}: face {f} is not in the mesh ({} faces)",
                     level.num_faces()
                 ))
@@ -173,7 +173,7 @@ impl Refiner {
     /// Refines uniformly `levels` times.
     pub fn refine_uniform(&self, levels: usize) -> Result<Hierarchy> {
         if levels > 12 {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "{levels} levels requested; uniform refinement multiplies faces by 4 per level, \
                  so more than 12 levels is refused"
             )));
@@ -242,7 +242,7 @@ impl Hierarchy {
     /// The composed table `S = S_{n−1} ⋯ S_0` with `P_n = S P_0`.
     pub fn stencil_to_level(&self, n: usize) -> Result<StencilTable> {
         if n > self.num_levels() {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "level {n} requested but the hierarchy has {} levels",
                 self.num_levels()
             )));

@@ -27,13 +27,13 @@ pub fn estimated_faces(mesh: &PolyMesh, levels: usize) -> f64 {
 /// limit stencils too.
 pub fn check_uniform_size(mesh: &PolyMesh, levels: usize, limit: bool) -> Result<()> {
     if levels > MAX_LEVELS {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "{levels} levels is too many: each level multiplies the faces by 4; at most {MAX_LEVELS} levels are allowed"
         )));
     }
     let faces = estimated_faces(mesh, levels);
     if faces > MAX_FACES as f64 {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "{levels} levels would make about {:.0} million faces (at most {} million allowed); use fewer levels",
             faces / 1e6,
             MAX_FACES / 1_000_000
@@ -79,5 +79,5 @@ pub fn uniform_positions(
     }
     h.refine_positions(p0)?
         .pop()
-        .ok_or_else(|| Error::Input("the refinement produced no level".into()))
+        .ok_or_else(|| Error::input("the refinement produced no level"))
 }

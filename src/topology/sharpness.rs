@@ -34,7 +34,7 @@ impl std::str::FromStr for CreaseMethod {
         match s {
             "uniform" => Ok(CreaseMethod::Uniform),
             "chaikin" => Ok(CreaseMethod::Chaikin),
-            _ => Err(Error::Input(format!(
+            _ => Err(Error::input(format!(
                 "unknown crease method '{s}': expected uniform or chaikin"
             ))),
         }
@@ -105,12 +105,12 @@ impl Sharpness {
         let mut edge = vec![0.0; level.num_edges()];
         for (k, &(i, j, s)) in creases.iter().enumerate() {
             if s.is_nan() || s < 0.0 {
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "crease {k} ({i}, {j}) has sharpness {s}; sharpness must be ≥ 0"
                 )));
             }
             let e = find_edge(level, i, j).ok_or_else(|| {
-                Error::Input(format!(
+                Error::input(format!(
                     "crease {k}: vertices {i} and {j} are not joined by an edge of the mesh"
                 ))
             })?;
@@ -134,12 +134,12 @@ impl Sharpness {
             .collect();
         for (k, &(v, s)) in vertex_sharpness.iter().enumerate() {
             if s.is_nan() || s < 0.0 {
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "vertex sharpness {k} (vertex {v}) is {s}; sharpness must be ≥ 0"
                 )));
             }
             let slot = vertex.get_mut(v as usize).ok_or_else(|| {
-                Error::Input(format!(
+                Error::out_of_range(format!(
                     "vertex sharpness {k}: vertex {v} is not in the mesh ({} vertices)",
                     level.num_vertices
                 ))

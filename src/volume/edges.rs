@@ -25,7 +25,7 @@ pub fn edge_potential(smoothed: &Volume) -> Result<Volume> {
         .linear()
         .try_inverse()
         .map(|m| m.transpose())
-        .ok_or_else(|| Error::Input("singular voxel-to-world map".into()))?;
+        .ok_or_else(|| Error::input("singular voxel-to-world map"))?;
     let d = smoothed.data();
     let slab = nx * ny;
     let diff = |i: usize, n: usize, stride: usize, at: usize| -> Real {
@@ -57,8 +57,8 @@ pub fn edge_potential(smoothed: &Volume) -> Result<Volume> {
     });
     let max = out.par_iter().cloned().reduce(|| 0.0, f32::max);
     if max.is_nan() || max <= 0.0 {
-        return Err(Error::Input(
-            "the volume is constant: it has no edges to recover a shape from".into(),
+        return Err(Error::input(
+            "the volume is constant: it has no edges to recover a shape from",
         ));
     }
     out.par_iter_mut().for_each(|v| *v = -*v / max);

@@ -41,7 +41,7 @@ pub fn gaussian_smoothed_owned(volume: Volume, sigma: Real) -> Result<Volume> {
 /// negative or non-finite σ, or one far wider than the volume.
 fn kernels_of(volume: &Volume, sigma: Real) -> Result<Vec<Vec<f32>>> {
     if !(sigma.is_finite() && sigma >= 0.0) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "smoothing sigma {sigma} must be a finite length ≥ 0"
         )));
     }
@@ -52,7 +52,7 @@ fn kernels_of(volume: &Volume, sigma: Real) -> Result<Vec<Vec<f32>>> {
     for a in 0..3 {
         let half = half_width(sigma / spacing[a]);
         if half > (4 * dims[a].max(64)) as Real {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "smoothing sigma {sigma} spans {half:.0} voxels along axis {a}, far beyond the volume"
             )));
         }

@@ -44,7 +44,7 @@ impl Volume {
         origin: Point3,
     ) -> Result<Self> {
         if dims.contains(&0) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "volume dimensions {}×{}×{} contain a zero",
                 dims[0], dims[1], dims[2]
             )));
@@ -52,9 +52,9 @@ impl Volume {
         let n = dims
             .iter()
             .try_fold(1usize, |acc, &d| acc.checked_mul(d))
-            .ok_or_else(|| Error::Input("volume dimensions overflow".into()))?;
+            .ok_or_else(|| Error::input("volume dimensions overflow"))?;
         if n != data.len() {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "volume of {}×{}×{} = {n} voxels given {} samples",
                 dims[0],
                 dims[1],
@@ -63,7 +63,7 @@ impl Volume {
             )));
         }
         if let Some(i) = data.iter().position(|v| !v.is_finite()) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "voxel {i} (x {}, y {}, z {}) is {}: volumes must be finite",
                 i % dims[0],
                 (i / dims[0]) % dims[1],
@@ -72,14 +72,12 @@ impl Volume {
             )));
         }
         if !(linear.iter().all(|v| v.is_finite()) && origin.iter().all(|v| v.is_finite())) {
-            return Err(Error::Input("the voxel-to-world map is not finite".into()));
+            return Err(Error::non_finite("the voxel-to-world map is not finite"));
         }
         let inverse = linear
             .try_inverse()
             .filter(|m| m.iter().all(|v| v.is_finite()))
-            .ok_or_else(|| {
-                Error::Input("the voxel-to-world map is singular (a zero spacing?)".into())
-            })?;
+            .ok_or_else(|| Error::input("the voxel-to-world map is singular (a zero spacing?)"))?;
         Ok(Volume {
             dims,
             data,

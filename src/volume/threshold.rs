@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 pub fn otsu_threshold(volume: &Volume) -> Result<f32> {
     let (lo, hi) = volume.range();
     if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "the volume is constant ({lo}): no threshold separates an object"
         )));
     }

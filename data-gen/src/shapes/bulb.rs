@@ -44,14 +44,14 @@ fn ray_root(phi: Real) -> Result<Real> {
         let (a, b) = (i as Real * dt, (i + 1) as Real * dt);
         if (f(a) < 0.0) != (f(b) < 0.0) {
             if crossing.is_some() {
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "bulb profile is not star-shaped at angle {phi}"
                 )));
             }
             crossing = Some((a, b));
         }
     }
-    let (mut a, mut b) = crossing.ok_or_else(|| Error::Input("bulb profile not found".into()))?;
+    let (mut a, mut b) = crossing.ok_or_else(|| Error::input("bulb profile not found"))?;
     for _ in 0..200 {
         let m = 0.5 * (a + b);
         if m == a || m == b {

@@ -119,7 +119,7 @@ pub fn build_shape(kind: ShapeKind, params: &ShapeParams) -> Result<Shape> {
     let (default, min, max) = kind.resolution_range();
     let n = params.resolution.unwrap_or(default);
     if !(min..=max).contains(&n) {
-        return Err(Error::Input(format!(
+        return Err(Error::out_of_range(format!(
             "--resolution {n} is out of range for {}: {min}..={max}",
             kind.name()
         )));
@@ -128,7 +128,7 @@ pub fn build_shape(kind: ShapeKind, params: &ShapeParams) -> Result<Shape> {
         if x.is_finite() && x > 0.0 {
             Ok(x)
         } else {
-            Err(Error::Input(format!(
+            Err(Error::input(format!(
                 "{name} must be a positive number, got {x}"
             )))
         }
@@ -181,7 +181,7 @@ pub fn build_shape(kind: ShapeKind, params: &ShapeParams) -> Result<Shape> {
                 positive("--minor", params.minor)?,
             );
             if small >= big {
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "--minor {small} must be smaller than --major {big} (a ring torus)"
                 )));
             }

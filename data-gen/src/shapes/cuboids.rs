@@ -125,7 +125,7 @@ pub fn cuboid_solid_mesh(solid: &CuboidSolid, resolution: usize) -> Result<PolyM
     let axes: [Vec<Real>; 3] = std::array::from_fn(|k| axis_coordinates(solid, k, step));
     let n: [usize; 3] = std::array::from_fn(|k| axes[k].len() - 1);
     if n[0] * n[1] * n[2] > 50_000_000 {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "a {}×{}×{} grid is too large; lower the resolution",
             n[0], n[1], n[2]
         )));

@@ -38,7 +38,7 @@ pub fn marching_tetrahedra(field: &Field, lo: Point3, hi: Point3, cell: Real) ->
     let n: [usize; 3] = std::array::from_fn(|k| ((hi[k] - origin[k]) / cell).ceil() as usize + 1);
     let (nx, ny, nz) = (n[0] + 1, n[1] + 1, n[2] + 1);
     if nx * ny * nz > 200_000_000 {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "a {}×{}×{} grid is too large; lower the resolution",
             n[0], n[1], n[2]
         )));
@@ -53,8 +53,8 @@ pub fn marching_tetrahedra(field: &Field, lo: Point3, hi: Point3, cell: Real) ->
         let (i, j, k) = (g % nx, (g / nx) % ny, g / (nx * ny));
         let on_boundary = i == 0 || j == 0 || k == 0 || i == nx - 1 || j == ny - 1 || k == nz - 1;
         if on_boundary && value <= 0.0 {
-            return Err(Error::Input(
-                "the shape reaches the boundary of its polygonisation grid".into(),
+            return Err(Error::input(
+                "the shape reaches the boundary of its polygonisation grid",
             ));
         }
     }

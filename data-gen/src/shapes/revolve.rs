@@ -12,13 +12,13 @@ use subdyn::mesh::PolyMesh;
 pub fn surface_of_revolution(profile: &[(Real, Real)], segments: usize) -> Result<PolyMesh> {
     let m = profile.len().saturating_sub(1);
     if m < 2 || segments < 3 {
-        return Err(Error::Input(
-            "a surface of revolution needs 3 profile points and 3 segments".into(),
+        return Err(Error::input(
+            "a surface of revolution needs 3 profile points and 3 segments",
         ));
     }
     if profile[0].0 != 0.0 || profile[m].0 != 0.0 || profile[1..m].iter().any(|p| p.0 <= 0.0) {
-        return Err(Error::Input(
-            "the profile must start and end on the axis and stay off it in between".into(),
+        return Err(Error::input(
+            "the profile must start and end on the axis and stay off it in between",
         ));
     }
     let s = segments;

@@ -73,7 +73,7 @@ impl PrincipalFrame {
         let ext = frame.extents();
         let widest = ext[0].max(ext[1]).max(ext[2]);
         if widest <= DEGENERATE * scale {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "all {} points are identical (at {:.6}, {:.6}, {:.6}); an initial model needs a spread of points",
                 points.len(),
                 centroid.x,
@@ -84,7 +84,7 @@ impl PrincipalFrame {
         let mut sorted = ext;
         sorted.sort_by(|a, b| b.total_cmp(a));
         if sorted[1] <= DEGENERATE * widest {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "the {} points are collinear (extent {widest:.6e} along their line, {:.3e} across it); \
                  an initial model needs points spread over a surface",
                 points.len(),
@@ -131,8 +131,8 @@ impl PrincipalFrame {
 /// coordinates finite. Errors are [`Error::Input`] naming the problem.
 pub fn check_points(points: &[Point3]) -> Result<()> {
     if points.is_empty() {
-        return Err(Error::Input(
-            "the point cloud is empty; an initial model needs points".into(),
+        return Err(Error::input(
+            "the point cloud is empty; an initial model needs points",
         ));
     }
     if let Some(i) = first_non_finite(points) {
@@ -140,7 +140,7 @@ pub fn check_points(points: &[Point3]) -> Result<()> {
             .iter()
             .filter(|p| !p.coords.iter().all(|c| c.is_finite()))
             .count();
-        return Err(Error::Input(format!(
+        return Err(Error::non_finite(format!(
             "point {i} has a non-finite coordinate ({}, {}, {}); {bad} of {} points are not finite",
             points[i].x,
             points[i].y,
@@ -149,7 +149,7 @@ pub fn check_points(points: &[Point3]) -> Result<()> {
         )));
     }
     if points.len() < MIN_POINTS {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "only {} points; an initial model needs at least {MIN_POINTS}",
             points.len()
         )));

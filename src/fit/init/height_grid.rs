@@ -162,8 +162,8 @@ pub fn height_grid(
         }
     }
     if faces.is_empty() {
-        return Err(Error::Input(
-            "no grid cell holds enough points for an open initial model".into(),
+        return Err(Error::input(
+            "no grid cell holds enough points for an open initial model",
         ));
     }
     let mesh = PolyMesh::from_faces(positions, &faces)?;

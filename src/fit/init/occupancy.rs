@@ -247,8 +247,8 @@ pub fn occupancy_cage(
         let repair = make_manifold(&mut solid);
         dropped_components += solid.keep_largest_component();
         if solid.count() == 0 {
-            return Err(Error::Input(
-                "the points' occupancy is empty; cannot build an occupancy cage".into(),
+            return Err(Error::input(
+                "the points' occupancy is empty; cannot build an occupancy cage",
             ));
         }
         let blocky = boundary_quads(&solid, |c| local(c.map(|x| x as Real)))?;

@@ -48,7 +48,7 @@ impl std::str::FromStr for InitKind {
             "closed" | "ellipsoid" => Ok(InitKind::Closed),
             "open" | "grid" => Ok(InitKind::Open),
             "occupancy" | "voxel" => Ok(InitKind::Occupancy),
-            _ => Err(Error::Input(format!(
+            _ => Err(Error::input(format!(
                 "unknown initial model '{s}': expected auto, closed, open or occupancy"
             ))),
         }
@@ -102,33 +102,32 @@ impl InitParams {
     /// Checks the ranges documented on each field.
     pub fn validate(&self) -> Result<()> {
         if !(2..=MAX_RESOLUTION).contains(&self.resolution) {
-            return Err(Error::Input(format!(
+            return Err(Error::out_of_range(format!(
                 "initial-model resolution {} is out of range: expected 2 to {MAX_RESOLUTION} cells",
                 self.resolution
             )));
         }
         if !(self.closed_threshold.is_finite() && (0.0..=1.0).contains(&self.closed_threshold)) {
-            return Err(Error::Input(format!(
+            return Err(Error::out_of_range(format!(
                 "closed threshold {} is out of range: expected a fraction in [0, 1]",
                 self.closed_threshold
             )));
         }
         if !(1.0..=8.0).contains(&self.max_refinement) {
-            return Err(Error::Input(format!(
+            return Err(Error::out_of_range(format!(
                 "occupancy refinement {} is out of range: expected 1 to 8",
                 self.max_refinement
             )));
         }
         if self.smoothing_steps > 1000 {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "{} smoothing steps requested; at most 1000 allowed",
                 self.smoothing_steps
             )));
         }
         if self.min_cell_points == 0 {
-            return Err(Error::Input(
-                "min_cell_points must be at least 1 (empty cells are never part of the footprint)"
-                    .into(),
+            return Err(Error::input(
+                "min_cell_points must be at least 1 (empty cells are never part of the footprint)",
             ));
         }
         Ok(())

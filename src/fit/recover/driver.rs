@@ -280,8 +280,8 @@ impl LevelFit for VolumeFit<'_> {
                 .collect();
             let total: Real = found.iter().map(|f| f.1).sum();
             if total.is_nan() || total <= 0.0 {
-                return Err(Error::Input(
-                    "the model's limit surface has no area; is the initial mesh degenerate?".into(),
+                return Err(Error::input(
+                    "the model's limit surface has no area; is the initial mesh degenerate?",
                 ));
             }
             let beyond: Vec<Real> = xs

@@ -17,7 +17,7 @@ use super::voxel_components::{components, iso_crossings};
 /// about `radius` around `centre`.
 pub fn seed_cage(centre: Point3, radius: Real) -> Result<PolyMesh> {
     if !(radius.is_finite() && radius > 0.0) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "seed radius {radius} must be positive"
         )));
     }
@@ -119,14 +119,14 @@ pub fn component_cage(
         Some(s) => {
             let c = volume.continuous_index(&s).map(|x| x.round());
             if !volume.contains(&s) {
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "seed ({}, {}, {}) lies outside the volume",
                     s.x, s.y, s.z
                 )));
             }
             let l = label[volume.index(c[0] as usize, c[1] as usize, c[2] as usize)];
             if l == u32::MAX {
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "seed ({}, {}, {}) is not inside the object: its voxel is {} the level {level}",
                     s.x,
                     s.y,
@@ -141,14 +141,14 @@ pub fn component_cage(
             l as usize
         }
         None => (0..sizes.len()).max_by_key(|&i| sizes[i]).ok_or_else(|| {
-            Error::Input(format!(
+            Error::input(format!(
                 "no voxel is {} the level {level}: nothing to recover",
                 if bright_inside { "above" } else { "below" }
             ))
         })?,
     };
     if sizes[chosen] < 8 {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "the object's component has only {} voxels; too small to recover",
             sizes[chosen]
         )));
@@ -158,7 +158,7 @@ pub fn component_cage(
     let block = extent.div_ceil(resolution.max(2)).max(1);
     let main =
         part_cage(volume, &label, chosen as u32, boxes[chosen], block)?.ok_or_else(|| {
-            Error::Input(format!(
+            Error::input(format!(
                 "the object ({} voxels) vanishes at {block}-voxel blocks; raise the resolution",
                 sizes[chosen]
             ))

@@ -156,14 +156,13 @@ pub fn opened_at_box(control: &PolyMesh, padded: &Volume) -> Result<PolyMesh> {
         }
     }
     if keep.len() == control.num_faces() {
-        return Err(Error::Input(
-            "opening at the box: the object does not reach the volume's box, nothing to open"
-                .into(),
+        return Err(Error::input(
+            "opening at the box: the object does not reach the volume's box, nothing to open",
         ));
     }
     if keep.is_empty() {
-        return Err(Error::Input(
-            "opening at the box: the whole surface lies on the volume's box".into(),
+        return Err(Error::input(
+            "opening at the box: the whole surface lies on the volume's box",
         ));
     }
     let mut new_index = vec![u32::MAX; control.num_vertices()];

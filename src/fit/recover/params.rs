@@ -166,7 +166,7 @@ impl RecoverParams {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(Error::Input(format!(
+                Err(Error::input(format!(
                     "{name} {v} must be a positive number"
                 )))
             }
@@ -175,17 +175,19 @@ impl RecoverParams {
             if v.is_finite() && v >= 0.0 {
                 Ok(())
             } else {
-                Err(Error::Input(format!(
+                Err(Error::input(format!(
                     "{name} {v} must be a finite number ≥ 0"
                 )))
             }
         };
         match self.boundary {
             BoundaryModel::Iso { value } if !value.is_finite() => {
-                return Err(Error::Input(format!("iso-value {value} is not finite")));
+                return Err(Error::non_finite(format!(
+                    "iso-value {value} is not finite"
+                )));
             }
             BoundaryModel::Edge { min_strength } if !(0.0..1.0).contains(&min_strength) => {
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "edge strength {min_strength} must be in [0, 1)"
                 )));
             }
@@ -196,13 +198,13 @@ impl RecoverParams {
         }
         positive("tolerance", self.tolerance_voxels)?;
         if self.max_level > 6 {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "max level {} is absurd: each level has four times the faces; at most 6",
                 self.max_level
             )));
         }
         if self.max_steps == 0 || self.max_steps > 100_000 {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "max steps {} must be between 1 and 100000",
                 self.max_steps
             )));
@@ -222,28 +224,28 @@ impl RecoverParams {
         positive("two-sided distance", self.two_sided_voxels)?;
         positive("max control share", self.max_control_share)?;
         if !(self.max_level_growth.is_finite() && self.max_level_growth > 1.0) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "max level growth {} must be a number above 1",
                 self.max_level_growth
             )));
         }
         if !(0.0..=1.0).contains(&self.max_unmatched) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "max unmatched {} must be a fraction in [0, 1]",
                 self.max_unmatched
             )));
         }
         if !(0.0..=1.0).contains(&self.max_unresolved) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "max unresolved {} must be a fraction in [0, 1]",
                 self.max_unresolved
             )));
         }
         if !self.inflation.is_finite() {
-            return Err(Error::Input("inflation must be finite".into()));
+            return Err(Error::input("inflation must be finite"));
         }
         if !(1..=8).contains(&self.quadrature_order) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "quadrature order {} must be between 1 and 8",
                 self.quadrature_order
             )));

@@ -76,14 +76,14 @@ fn checked_sigma(volume: &Volume, params: &RecoverParams) -> Result<Real> {
     params.check()?;
     let (lo, hi) = volume.range();
     if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "the volume is constant ({lo}): there is no boundary to recover"
         )));
     }
     if let BoundaryModel::Iso { value } = params.boundary
         && !(value > lo as Real && value < hi as Real)
     {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "iso-value {value} lies outside the volume's range [{lo}, {hi}]"
         )));
     }

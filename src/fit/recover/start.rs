@@ -72,7 +72,7 @@ pub fn initial_model(
         } => {
             if !volume.contains(p) {
                 let (lo, hi) = volume.world_bounds();
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "seed ({}, {}, {}) lies outside the volume, which spans ({:.2}, {:.2}, {:.2}) to ({:.2}, {:.2}, {:.2})",
                     p.x, p.y, p.z, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
                 )));
@@ -84,7 +84,7 @@ pub fn initial_model(
                 v < prepared.inside_level
             };
             if !inside {
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "seed ({}, {}, {}) is not inside the object: the smoothed intensity there is {v:.4}, {} the inside level {:.4}",
                     p.x,
                     p.y,
@@ -98,7 +98,7 @@ pub fn initial_model(
                 )));
             }
             if !(radius_voxels.is_finite() && *radius_voxels > 0.0) {
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "seed radius {radius_voxels} must be positive"
                 )));
             }
@@ -123,7 +123,7 @@ pub fn initial_model(
         }
         RecoverStart::Auto { seed, resolution } => {
             if !(2..=128).contains(resolution) {
-                return Err(Error::Input(format!(
+                return Err(Error::out_of_range(format!(
                     "resolution {resolution} is out of range: expected 2 to 128"
                 )));
             }

@@ -67,7 +67,7 @@ impl PatchAssembly {
                         let (cols, es) = element(f);
                         let k = cols.len();
                         if let Some(x) = es.iter().find(|x| x.len() != k * k) {
-                            return Err(Error::Input(format!(
+                            return Err(Error::size_mismatch(format!(
                                 "patch {f}'s element has {} entries for {k} columns",
                                 x.len()
                             )));

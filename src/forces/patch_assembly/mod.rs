@@ -127,7 +127,7 @@ impl PatchAssembly {
         let mut block = Vec::with_capacity(rings.len());
         for (ring, sup, at, cols) in rings {
             if at.len() >= u16::MAX as usize {
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "a patch's one-ring has {} control-point terms, more than 65,534",
                     at.len()
                 )));
@@ -142,7 +142,7 @@ impl PatchAssembly {
         }
         let rings = ring_lists;
         if let Some(big) = supports.iter().find(|sup| sup.len() > u16::MAX as usize) {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "a patch depends on {} control points, more than 65,535",
                 big.len()
             )));
@@ -207,7 +207,7 @@ impl PatchAssembly {
             .collect();
         let slot_offsets = offsets_of(per_block.iter().map(Vec::len));
         if indices.len() > u32::MAX as usize {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "the control-point system would have {} entries, more than 2³² − 1",
                 indices.len()
             )));
@@ -240,7 +240,7 @@ impl PatchAssembly {
     pub fn values_of(&self, m: &StencilTable) -> Result<Vec<Real>> {
         let n = self.offsets.len() - 1;
         if m.num_rows() != n || m.num_cols != n {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "a {}×{} matrix for a system of {n} control points",
                 m.num_rows(),
                 m.num_cols
@@ -256,7 +256,7 @@ impl PatchAssembly {
                     Ok(k) => values[lo + k] += w,
                     Err(_) if w == 0.0 => {}
                     Err(_) => {
-                        return Err(Error::Input(format!(
+                        return Err(Error::input(format!(
                             "matrix entry ({r}, {c}) = {w} lies outside the patches' supports"
                         )));
                     }
@@ -361,7 +361,7 @@ fn check_lengths(a: usize, b: usize, c: usize) -> Result<()> {
     if a == b && b == c {
         Ok(())
     } else {
-        Err(Error::Input(format!(
+        Err(Error::size_mismatch(format!(
             "springs: mismatched lengths {a}, {b} and {c}"
         )))
     }

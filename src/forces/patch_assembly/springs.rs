@@ -147,7 +147,7 @@ impl PatchAssembly {
     pub fn rows_at(&self, table: &PatchTable, at: &[(usize, [Real; 2])]) -> Result<PatchRows> {
         let patches = self.block.len();
         if table.num_patches() != patches {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "a table of {} patches for an assembly of {patches}",
                 table.num_patches()
             )));
@@ -162,7 +162,7 @@ impl PatchAssembly {
                 let (mut u, mut out) = (Vec::new(), Chunk::default());
                 for (i, &(f, st)) in chunk.iter().enumerate() {
                     if f >= patches {
-                        return Err(Error::Input(format!(
+                        return Err(Error::input(format!(
                             "row {} is on patch {f} of {patches}",
                             c * ROWS_PER_CHUNK + i
                         )));
@@ -239,7 +239,7 @@ impl PatchAssembly {
         for i in 0..count {
             let f = patch_of(i);
             if f >= patches {
-                return Err(Error::Input(format!(
+                return Err(Error::input(format!(
                     "spring {i} is on patch {f} of {patches}"
                 )));
             }
@@ -273,7 +273,7 @@ impl PatchAssembly {
                         continue;
                     }
                     if !(k > 0.0 && k.is_finite()) {
-                        return Err(Error::Input(format!("spring {i} has stiffness {k}")));
+                        return Err(Error::input(format!("spring {i} has stiffness {k}")));
                     }
                     energy += 0.5 * k * (x - d).norm_squared();
                     for a in 0..m {

@@ -207,14 +207,14 @@ fn check_options(options: &VolumeReadOptions) -> Result<()> {
     if let Some(s) = options.spacing
         && !s.iter().all(|x| x.is_finite() && *x > 0.0)
     {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "--spacing {s:?}: every voxel size must be a positive number"
         )));
     }
     if let Some(o) = options.origin
         && !o.iter().all(|x| x.is_finite())
     {
-        return Err(Error::Input(format!(
+        return Err(Error::input(format!(
             "--origin {o:?}: coordinates must be finite numbers"
         )));
     }

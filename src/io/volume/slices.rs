@@ -99,7 +99,7 @@ pub(crate) struct Stacked {
 /// stays near one volume), checking that they agree in size and kind.
 pub(crate) fn stacked(slices: Vec<(&PathBuf, Slice)>) -> Result<Stacked> {
     let Some((first, s0)) = slices.first() else {
-        return Err(Error::Input("no slices to stack".into()));
+        return Err(Error::input("no slices to stack"));
     };
     let (first, width, height, kind) = ((*first).clone(), s0.width, s0.height, s0.kind.clone());
     let depth = slices.len();

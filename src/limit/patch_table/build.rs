@@ -30,12 +30,12 @@ impl PatchTable {
         shapes: QuadtreeCache,
     ) -> Result<PatchTable> {
         if level == 0 || level > 6 {
-            return Err(Error::Input(format!(
+            return Err(Error::input(format!(
                 "patch level {level} must be between 1 and 6"
             )));
         }
         if positions.len() != refiner.level.num_vertices {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "{} positions for a mesh of {} vertices",
                 positions.len(),
                 refiner.level.num_vertices
@@ -131,7 +131,7 @@ impl PatchTable {
     pub fn set_positions(&mut self, positions: &[Point3]) -> Result<()> {
         crate::mesh::check_finite(positions)?;
         if positions.len() != self.to_level.num_cols {
-            return Err(Error::Input(format!(
+            return Err(Error::size_mismatch(format!(
                 "{} control points for a patch table over {}",
                 positions.len(),
                 self.to_level.num_cols

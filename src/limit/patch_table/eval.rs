@@ -66,7 +66,7 @@ impl PatchTable {
     /// Limit position and derivatives at base sample `(face, u, v)`.
     pub fn evaluate(&self, face: usize, u: Real, v: Real) -> Result<LimitPoint> {
         if face + 1 >= self.offsets[0].len() {
-            return Err(Error::Input(format!("face {face} out of range")));
+            return Err(Error::out_of_range(format!("face {face} out of range")));
         }
         let (f, st) = self.locate(face, u, v);
         let e = self.eval(f, st)?;
